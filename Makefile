@@ -1,0 +1,113 @@
+# lubkit build.
+#
+#   make            build build/lib/liblub.a and every program into build/bin/
+#   make test       unit tests of src/ and case tests of the programs; ends "N passed, N failed"
+#   make demo       install missing packages, build, run the wedge tutorial, print its error
+#   make bench      benchmarks (microseconds per particle-step, time to accuracy)
+#   make install PREFIX=/usr/local
+#   make clean
+#
+# Sources are found by globbing: a file src/<concern>/<name>.c joins the library, a folder
+# applications/<kind>/<program>/ becomes build/bin/<program>, a file tests/unit/<name>_test.c
+# becomes the test program build/tests/<name>_test.  Nothing needs to be listed here.
+#
+# SANITIZE=address builds into build-asan/ with AddressSanitizer (make SANITIZE=address test).
+
+CC       ?= cc
+PREFIX   ?= /usr/local
+OPT      ?= -O2
+BUILD    ?= build
+
+ifeq ($(SANITIZE),address)
+  BUILD  := build-asan
+  OPT    := -O1 -fno-omit-frame-pointer -fsanitize=address,undefined
+  LDSAN  := -fsanitize=address,undefined
+endif
+
+# Dependencies: pkg-config where the Debian package ships a .pc file (libyaml, HDF5);
+# SuiteSparse 5 (Debian 12) ships none, so CHOLMOD is found by its header folder.
+PKGS          := yaml-0.1 hdf5
+PKG_CFLAGS    := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+PKG_LIBS      := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
+CHOLMOD_INC   ?= $(firstword $(wildcard /usr/include/suitesparse /usr/local/include/suitesparse))
+CHOLMOD_LIBS  ?= -lcholmod -lsuitesparseconfig
+
+VERSION  := $(shell cat VERSION 2>/dev/null || echo 0.0.0)
+GITREV   := $(shell git rev-parse --short HEAD 2>/dev/null || echo unknown)
+
+CPPFLAGS += -Isrc $(if $(CHOLMOD_INC),-I$(CHOLMOD_INC)) $(PKG_CFLAGS) \
+            -D_POSIX_C_SOURCE=200809L -DLUB_VERSION='"$(VERSION)"' -DLUB_GITREV='"$(GITREV)"'
+CFLAGS   += -std=c11 $(OPT) -g -Wall -Wextra -fopenmp -MMD -MP
+LDLIBS   += $(PKG_LIBS) $(CHOLMOD_LIBS) -lm
+LDFLAGS  += -fopenmp $(LDSAN)
+
+LIB_SRC   := $(sort $(shell find src -name '*.c'))
+LIB_OBJ   := $(LIB_SRC:%.c=$(BUILD)/obj/%.o)
+LIB       := $(BUILD)/lib/liblub.a
+
+APP_DIRS  := $(sort $(dir $(wildcard applications/*/*/*.c)))
+PROGRAMS  := $(foreach d,$(APP_DIRS),$(notdir $(patsubst %/,%,$(d))))
+BINS      := $(PROGRAMS:%=$(BUILD)/bin/%)
+
+TEST_SRC  := $(sort $(wildcard tests/unit/*_test.c))
+TEST_BINS := $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%)
+
+.PHONY: all test demo bench install clean deps format tests
+.SECONDARY:
+all: $(LIB) $(BINS)
+
+$(BUILD)/obj/%.o: %.c
+	@mkdir -p $(dir $@)
+	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+
+$(LIB): $(LIB_OBJ)
+	@mkdir -p $(dir $@)
+	@rm -f $@
+	ar rcs $@ $^
+
+# One program per folder: every .c in applications/<kind>/<program>/ is linked into it.
+define program_rule
+$(BUILD)/bin/$(1): $(patsubst %.c,$(BUILD)/obj/%.o,$(wildcard $(2)*.c)) $(LIB)
+	@mkdir -p $$(dir $$@)
+	$$(CC) $$(LDFLAGS) -o $$@ $$^ $$(LDLIBS)
+endef
+$(foreach d,$(APP_DIRS),$(eval $(call program_rule,$(notdir $(patsubst %/,%,$(d))),$(d))))
+
+$(BUILD)/tests/%_test: $(BUILD)/obj/tests/unit/%_test.o $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
+tests: all $(TEST_BINS)
+
+# deps: install missing Debian packages only when pkg-config or the CHOLMOD header is missing.
+deps:
+	@pkg-config --exists $(PKGS) 2>/dev/null && [ -n "$(CHOLMOD_INC)" ] \
+	  && command -v gnuplot >/dev/null || bin/installDeps
+
+# The recursive make re-reads pkg-config after deps may have installed packages.
+test: deps
+	@$(MAKE) --no-print-directory tests
+	@LUB_BUILD=$(BUILD) tests/run
+
+demo: deps
+	@$(MAKE) --no-print-directory all
+	@LUB_BUILD=$(BUILD) bin/lubDemo
+
+bench: deps
+	@$(MAKE) --no-print-directory all
+	@LUB_BUILD=$(BUILD) tests/bench/run
+
+install: all
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/share/lubkit
+	install -m 755 $(BINS) $(DESTDIR)$(PREFIX)/bin/
+	for f in bin/*; do install -m 755 $$f $(DESTDIR)$(PREFIX)/bin/; done
+	install -m 644 $(LIB) $(DESTDIR)$(PREFIX)/lib/
+	cp -r etc $(DESTDIR)$(PREFIX)/share/lubkit/
+
+format:
+	clang-format -i $$(find src applications tests -name '*.[ch]')
+
+clean:
+	rm -rf build build-asan tests/out
+
+-include $(shell find $(BUILD)/obj -name '*.d' 2>/dev/null)

@@ -1,0 +1,120 @@
+/* lubkit geometry: the case geometry of system/particleGenDict.yaml.
+ *
+ * One reader for the whole dictionary (lub_geometry_read), used by particleGen (which turns
+ * it into particles) and by reynoldsRef (which derives the gap h(x) from the same walls), so
+ * that both see the same case and the strict unknown-key check covers every entry.
+ *
+ * Dictionary layout (2-D example, the thesis wedge):
+ *
+ *     dimension:   2
+ *     l0:          5.0e-6            # single resolution; or `levels:` below
+ *     levels:                        # multi-resolution: each level owns an x-interval
+ *       - { l0: 5.0e-6, region: [-0.0036, 0.0030] }   # fine level owns [a1, a2]
+ *       - { l0: 4.0e-5 }                               # last level owns the rest
+ *     domain:      { min: [-0.0045, -2.0e-5], max: [0.0045, 3.0e-4] }
+ *     periodic:    [x]               # periodic directions: period = domain extent
+ *     dummyLayers: 2                 # dummy layers behind every wall (default 2)
+ *     wallGap:     1.0               # minimum fluid-wall distance in l0 (default 1.0)
+ *     walls:
+ *       lowerWall: { type: plane, point: [0, 0], normal: [0, 1] }     # normal into fluid
+ *       cylinder:  { type: cylinder, lowestPoint: [0, 4.0e-5], radius: 0.04,
+ *                    range: [-0.0045, 0.0045] }   # x-extent of the arc (optional)
+ *       ramp:      { type: segment, from: [0, 0], to: [1, 0.1], fluid: above }
+ *       profile:   { type: polyline, points: [[0, 0], [1, 0.2], [2, 0]], fluid: above }
+ *       tank:      { type: box, min: [0, 0], max: [1.61, 0.8], fluid: inside }
+ *       ball:      { type: sphere, centre: [0, 0, 1], radius: 0.1 }             # 3-D
+ *       shaft:     { type: cylinder, centre: [0, 0, 1], axis: [0, 0, 1], radius: 0.1 } # 3-D
+ *     fluid:
+ *       - { type: layer, wall: lowerWall, thickness: 8.0e-5 }   # film on a wall
+ *       - { type: box, min: [0, 0], max: [0.6, 0.3] }
+ *       - { type: between, lower: lowerWall, upper: cylinder, height: 8.0e-5 }
+ *
+ * cylinder: `centre` or `lowestPoint`; fluid `outside` (default) or `inside`.
+ * box, sphere: fluid `inside` or `outside` (box default inside: a tank; sphere outside).
+ * segment, polyline (2-D): fluid `above` (default) or `below`; polyline x must increase.
+ * `between ... height` fills from the lower wall up to `height` above the lower wall's
+ * surface, and not inside or beyond the upper wall.
+ */
+#ifndef LUB_GEOMETRY_GEOMETRY_H
+#define LUB_GEOMETRY_GEOMETRY_H
+
+#include "io/dict.h"
+#include "particles/particles.h"
+
+typedef enum {
+    LUB_WALL_PLANE,
+    LUB_WALL_SEGMENT,
+    LUB_WALL_CYLINDER,
+    LUB_WALL_POLYLINE,
+    LUB_WALL_BOX,
+    LUB_WALL_SPHERE
+} lub_wall_type;
+
+typedef struct {
+    char name[LUB_NAME_MAX];
+    lub_wall_type type;
+    const lub_node *node;       /* the dictionary entry (for messages) */
+    double point[3], normal[3]; /* plane: a point and the unit normal into the fluid */
+    double from[3], to[3];      /* segment */
+    double centre[3], radius;   /* cylinder (2-D circle; 3-D with axis), sphere */
+    double axis[3];             /* 3-D cylinder axis (unit) */
+    double *pts;                /* polyline: npts points (x, y) */
+    int npts;
+    double min[3], max[3];  /* box */
+    int fluid_inside;       /* cylinder, sphere, box */
+    int fluid_above;        /* segment, polyline */
+    int has_range;          /* cylinder arc / plane limited in x */
+    double range[2];
+} lub_wall;
+
+typedef enum { LUB_REGION_LAYER, LUB_REGION_BOX, LUB_REGION_BETWEEN } lub_region_type;
+
+typedef struct {
+    lub_region_type type;
+    const lub_node *node;
+    int wall;             /* layer: wall index */
+    double thickness;     /* layer */
+    double min[3], max[3]; /* box */
+    int lower, upper;     /* between: wall indices */
+    double height;        /* between */
+} lub_region;
+
+typedef struct {
+    double l0;
+    double xmin, xmax; /* owned x-interval (the last level: everything not owned before) */
+    int has_region;
+    const lub_node *node;
+} lub_level_spec;
+
+typedef struct {
+    const lub_dict *dict; /* the dictionary read (owned) */
+    int dim;
+    double dmin[3], dmax[3]; /* domain */
+    int periodic[3];
+    int dummy_layers;
+    double wall_gap; /* in l0 */
+    int nlevels;
+    lub_level_spec levels[LUB_MAX_LEVELS];
+    int nwalls;
+    lub_wall *walls;
+    int nregions;
+    lub_region *regions;
+} lub_geometry;
+
+/* Read system/particleGenDict.yaml (path given) strictly; fatal with file:line on bad input.
+ * Calls lub_dict_finish. */
+void lub_geometry_read(lub_geometry *g, const char *path);
+void lub_geometry_free(lub_geometry *g);
+
+/* Wall index by name, or -1. */
+int lub_geometry_find_wall(const lub_geometry *g, const char *name);
+
+/* Height of a wall's surface at x (2-D, or the z = 0 section in 3-D) as seen from the gap:
+ * for the upper wall of a gap (upper != 0) the lowest point of its surface at x, for the
+ * lower wall the highest.  Returns 1 and sets *y, or 0 when the wall does not span x. */
+int lub_wall_height(const lub_wall *w, double x, int upper, double *y);
+
+/* Signed distance from point x to the wall surface, positive on the fluid side. */
+double lub_wall_distance(const lub_wall *w, const double *x, int dim);
+
+#endif
