@@ -108,6 +108,6 @@ format:
 	clang-format -i $$(find src applications tests -name '*.[ch]')
 
 clean:
-	rm -rf build build-asan tests/out
+	rm -rf build build-asan
 
 -include $(shell find $(BUILD)/obj -name '*.d' 2>/dev/null)

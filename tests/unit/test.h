@@ -53,7 +53,7 @@ static int test_passed_ = 0, test_failed_ = 0;
 
 /* expr must raise a fatal error whose message contains sub; the message is kept in
  * test_last_error for further checks. */
-static char test_last_error[2048];
+static char test_last_error[2048] __attribute__((unused));
 #define CHECK_FATAL(expr, sub)                                                             \
     do {                                                                                   \
         lub_catcher c_;                                                                    \

@@ -1,0 +1,51 @@
+/* lubkit geometry discretisation: walls -> wall + dummy particles, fluid regions -> fluid
+ * particles, per resolution level.
+ *
+ * Lattice.  Every level k has a square (cubic) lattice of spacing l0_k.  In a periodic
+ * direction it is cell-centred, dmin + (i + 1/2) l0, so the period holds exactly
+ * period / l0 points and the distance across the seam is l0.  In the other directions it
+ * passes through the first axis-aligned plane (or box face) perpendicular to that direction,
+ * else through dmin + l0/2; all levels share that origin.  Axis-aligned planes and boxes are
+ * discretised on the lattice itself (their faces must lie on it), so corners of tanks are
+ * filled without gaps or duplicates; inclined planes, segments, polylines, cylinders and
+ * spheres are sampled along their surface at arc-length spacing l0, with the dummy layers as
+ * offset surfaces k l0 behind (concentric arcs R -/+ k l0 on cylinders and spheres).
+ *
+ * Ownership.  A point (wall, dummy or fluid) belongs to the level that owns its x (the first
+ * level whose region contains x, else the last level).
+ *
+ * Fluid.  Lattice points inside a region, on the fluid side of every wall, and at least
+ * 0.999 wallGap l0 from every wall and dummy particle (0.999 so that round-off does not remove
+ * the lattice row exactly one l0 from a wall).  A region left without particles is an error.
+ */
+#ifndef LUB_GEOMETRY_DISCRETISE_H
+#define LUB_GEOMETRY_DISCRETISE_H
+
+#include "geometry/geometry.h"
+#include "particles/particles.h"
+
+/* Reference values of a level on a full regular lattice around an interior particle:
+ * re = 3.1 l0, n0 (T-4), lambda0 (T-5) with w(r) = (r/re - 1)^2 for r < re (T-6). */
+void lub_level_reference(int dim, double l0, lub_level *lev);
+
+/* Upper bound of the particle count: lattice points of every level in the part of the
+ * domain it owns, plus the sampled walls. */
+double lub_geometry_estimate(const lub_geometry *g);
+
+/* Bytes of memory one particle needs during generation and in lub_particles. */
+#define LUB_GEN_BYTES_PER_PARTICLE 160.0
+
+/* Fill P (initialised here with g->dim) with the wall, dummy and fluid particles of g and
+ * set its levels and patches.  Fatal (exit 1, with the dictionary location) when the
+ * estimated count exceeds the memory (mem_bytes; 0: physical memory of the machine), when a
+ * fluid region ends up empty, or when an axis-aligned wall face is off the lattice.
+ * region_counts (may be NULL; g->nregions entries) receives the fluid particles found in each
+ * region (a particle inside two overlapping regions counts for both). */
+void lub_geometry_discretise(const lub_geometry *g, lub_particles *P, double mem_bytes,
+                             size_t *region_counts);
+
+/* 1 when point x lies behind wall w (inside its solid, deeper than tol) within the wall's
+ * span (x-range for planes, segments and polylines). */
+int lub_wall_behind(const lub_wall *w, const double *x, int dim, double tol);
+
+#endif

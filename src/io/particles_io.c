@@ -1,0 +1,1074 @@
+/* lubkit particle files: HDF5 particles.h5 and XDMF descriptions (see particles_io.h).
+ *
+ * Error handling.  HDF5's automatic error printing is switched off around every use of the
+ * library, and a failure is reported in our own words with the innermost HDF5 reason.  The
+ * fatal error is raised only after every HDF5 handle and buffer has been released, because
+ * lub_fatal may longjmp (unit tests) and the next test must find a clean library.  To make
+ * that simple every helper closes what it opened before returning, and files are opened with
+ * H5F_CLOSE_STRONG so that closing the file also closes anything a path forgot.
+ */
+#include "io/particles_io.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <math.h>
+#include <stdarg.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <hdf5.h>
+
+#include "core/error.h"
+
+static const char *const standard_fields[] = {"position", "velocity", "pressure", "kind",
+                                              "patch",    "level",    "id"};
+enum { N_STANDARD = sizeof standard_fields / sizeof *standard_fields };
+
+/* ------------------------------------------------------------------------------------------ */
+/* Error context                                                                              */
+
+typedef struct {
+    char msg[1024]; /* first failure, our words (+ HDF5 reason) */
+    int failed;
+    H5E_auto2_t old_func; /* HDF5 automatic error printing, restored on exit */
+    void *old_data;
+    void *buf;     /* scratch buffer, freed on every exit */
+    hid_t fapl;    /* file access property list */
+    hid_t file;    /* the open file */
+    int have_data; /* P holds storage that must be freed on failure */
+} h5ctx;
+
+static void ctx_begin(h5ctx *c)
+{
+    /* No library shutdown at exit: after a damaged file HDF5 1.10 may fail to release its
+     * internal state and print "infinite loop closing library" when the program exits.  Our
+     * files are always closed explicitly, so the shutdown has nothing to flush.  Effective
+     * only before the library is first used (else a harmless error, not reported). */
+    static int once = 0;
+    if (!once) {
+        once = 1;
+        H5dont_atexit();
+    }
+    memset(c, 0, sizeof *c);
+    c->fapl = c->file = H5I_INVALID_HID;
+    H5Eget_auto2(H5E_DEFAULT, &c->old_func, &c->old_data);
+    H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
+}
+
+/* Release everything; returns whether a failure was recorded. */
+static int ctx_end(h5ctx *c)
+{
+    if (c->file >= 0 && H5Fclose(c->file) < 0 && !c->failed) {
+        c->failed = 1;
+        snprintf(c->msg, sizeof c->msg, "cannot close the file");
+    }
+    c->file = H5I_INVALID_HID;
+    if (c->fapl >= 0) H5Pclose(c->fapl);
+    c->fapl = H5I_INVALID_HID;
+    free(c->buf);
+    c->buf = NULL;
+    H5Eclear2(H5E_DEFAULT);
+    H5Eset_auto2(H5E_DEFAULT, c->old_func, c->old_data);
+    return c->failed;
+}
+
+typedef struct {
+    char *buf;
+    size_t size;
+    int found;
+} reason_walk;
+
+/* H5Ewalk2 upward starts at the most specific entry: keep that one. */
+static herr_t reason_cb(unsigned n, const H5E_error2_t *e, void *data)
+{
+    reason_walk *r = data;
+    (void)n;
+    if (!r->found && e->desc && e->desc[0]) {
+        snprintf(r->buf, r->size, "%s", e->desc);
+        r->found = 1;
+    }
+    return 0;
+}
+
+static int vfail(h5ctx *c, int with_reason, const char *fmt, va_list ap)
+{
+    if (c->failed) return -1; /* keep the first failure */
+    c->failed = 1;
+    int n = vsnprintf(c->msg, sizeof c->msg, fmt, ap);
+    if (n < 0) n = 0;
+    if (n >= (int)sizeof c->msg) n = (int)sizeof c->msg - 1;
+    if (with_reason) {
+        char reason[512] = "";
+        reason_walk r = {reason, sizeof reason, 0};
+        H5Ewalk2(H5E_DEFAULT, H5E_WALK_UPWARD, reason_cb, &r);
+        H5Eclear2(H5E_DEFAULT);
+        if (r.found) snprintf(c->msg + n, sizeof c->msg - (size_t)n, " (HDF5: %s)", reason);
+    }
+    return -1;
+}
+
+/* A failure of our own checks. */
+static int fail(h5ctx *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static int fail(h5ctx *c, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vfail(c, 0, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+/* A failure of an HDF5 call: the message gets HDF5's innermost reason. */
+static int fail_h5(h5ctx *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+static int fail_h5(h5ctx *c, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    vfail(c, 1, fmt, ap);
+    va_end(ap);
+    return -1;
+}
+
+static void close_id(hid_t *id, herr_t (*closer)(hid_t))
+{
+    if (*id >= 0) closer(*id);
+    *id = H5I_INVALID_HID;
+}
+
+/* File access: closing the file closes every object in it; files are written in the HDF5
+ * 1.8 format, whose superblock and object headers carry checksums, so damaged metadata is
+ * detected when read instead of being decoded (HDF5 1.10 can crash decoding corrupted
+ * version-1 object headers).  Readable by every HDF5 since 1.8, ParaView's included. */
+static hid_t file_access_plist(int writing)
+{
+    hid_t fapl = H5Pcreate(H5P_FILE_ACCESS);
+    if (fapl < 0) return fapl;
+    if (H5Pset_fclose_degree(fapl, H5F_CLOSE_STRONG) < 0 ||
+        (writing && H5Pset_libver_bounds(fapl, H5F_LIBVER_V18, H5F_LIBVER_V18) < 0)) {
+        H5Pclose(fapl);
+        return H5I_INVALID_HID;
+    }
+    return fapl;
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Writing                                                                                    */
+
+static int write_attr(h5ctx *c, hid_t loc, const char *name, hid_t filetype, hid_t memtype,
+                      const void *value)
+{
+    hid_t s = H5Screate(H5S_SCALAR), a = H5I_INVALID_HID;
+    int rc = -1;
+    if (s < 0) {
+        fail_h5(c, "cannot create a dataspace");
+        goto out;
+    }
+    a = H5Acreate2(loc, name, filetype, s, H5P_DEFAULT, H5P_DEFAULT);
+    if (a < 0 || H5Awrite(a, memtype, value) < 0) {
+        fail_h5(c, "cannot write attribute '%s'", name);
+        goto out;
+    }
+    rc = 0;
+out:
+    close_id(&a, H5Aclose);
+    close_id(&s, H5Sclose);
+    return rc;
+}
+
+static int write_attr_string(h5ctx *c, hid_t loc, const char *name, const char *value)
+{
+    hid_t t = H5Tcopy(H5T_C_S1);
+    int rc = -1;
+    if (t < 0 || H5Tset_size(t, strlen(value) + 1) < 0 || H5Tset_strpad(t, H5T_STR_NULLTERM) < 0)
+        fail_h5(c, "cannot make a string type");
+    else
+        rc = write_attr(c, loc, name, t, t, value);
+    close_id(&t, H5Tclose);
+    return rc;
+}
+
+/* One contiguous dataset of n rows and ncols columns (ncols 1: rank 1). */
+static int write_dataset(h5ctx *c, hid_t g, const char *name, hid_t filetype, hid_t memtype,
+                         size_t n, int ncols, const void *data)
+{
+    hsize_t dims[2] = {(hsize_t)n, (hsize_t)ncols};
+    hid_t s = H5Screate_simple(ncols > 1 ? 2 : 1, dims, NULL), d = H5I_INVALID_HID;
+    int rc = -1;
+    if (s < 0) {
+        fail_h5(c, "cannot create the dataspace of '%s'", name);
+        goto out;
+    }
+    d = H5Dcreate2(g, name, filetype, s, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (d < 0) {
+        fail_h5(c, "cannot create dataset '%s'", name);
+        goto out;
+    }
+    if (n > 0 && H5Dwrite(d, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
+        fail_h5(c, "cannot write dataset '%s'", name);
+        goto out;
+    }
+    rc = 0;
+out:
+    close_id(&d, H5Dclose);
+    close_id(&s, H5Sclose);
+    return rc;
+}
+
+static hid_t make_group(h5ctx *c, hid_t loc, const char *name)
+{
+    hid_t g = H5Gcreate2(loc, name, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if (g < 0) fail_h5(c, "cannot create group '%s'", name);
+    return g;
+}
+
+/* Interleave three component arrays into an n x 3 buffer. */
+static void interleave(double *buf, double *const comp[3], size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        for (int d = 0; d < 3; d++) buf[3 * i + d] = comp[d][i];
+}
+
+static int write_contents(h5ctx *c, const lub_particles *P)
+{
+    hid_t f = c->file, g = H5I_INVALID_HID, t = H5I_INVALID_HID;
+    int64_t step = P->step;
+    int rc = -1;
+    if (write_attr_string(c, f, "format", LUB_PARTICLES_FORMAT) ||
+        write_attr(c, f, "time", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &P->time) ||
+        write_attr(c, f, "step", H5T_STD_I64LE, H5T_NATIVE_INT64, &step) ||
+        write_attr(c, f, "dimension", H5T_STD_I32LE, H5T_NATIVE_INT, &P->dim) ||
+        write_attr(c, f, "nLevels", H5T_STD_I32LE, H5T_NATIVE_INT, &P->nlevels))
+        goto out;
+
+    for (int k = 0; k < P->nlevels; k++) {
+        char name[32];
+        const lub_level *L = &P->levels[k];
+        snprintf(name, sizeof name, "level%d", k);
+        if ((g = make_group(c, f, name)) < 0 ||
+            write_attr(c, g, "l0", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &L->l0) ||
+            write_attr(c, g, "re", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &L->re) ||
+            write_attr(c, g, "n0", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &L->n0) ||
+            write_attr(c, g, "lambda0", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, &L->lambda0))
+            goto out;
+        close_id(&g, H5Gclose);
+    }
+
+    /* Patch names: fixed-length strings, simple to read back and to validate. */
+    t = H5Tcopy(H5T_C_S1);
+    if (t < 0 || H5Tset_size(t, LUB_NAME_MAX) < 0 || H5Tset_strpad(t, H5T_STR_NULLTERM) < 0) {
+        fail_h5(c, "cannot make a string type");
+        goto out;
+    }
+    if (write_dataset(c, f, "patches", t, t, (size_t)P->npatches, 1, P->patch_names)) goto out;
+
+    if ((g = make_group(c, f, "fields")) < 0) goto out;
+    size_t n = P->n;
+    double *buf = c->buf;
+    interleave(buf, P->x, n);
+    if (write_dataset(c, g, "position", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 3, buf)) goto out;
+    interleave(buf, P->u, n);
+    if (write_dataset(c, g, "velocity", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 3, buf) ||
+        write_dataset(c, g, "pressure", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 1, P->p) ||
+        write_dataset(c, g, "kind", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 1, P->kind) ||
+        write_dataset(c, g, "patch", H5T_STD_U16LE, H5T_NATIVE_UINT16, n, 1, P->patch) ||
+        write_dataset(c, g, "level", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 1, P->level) ||
+        write_dataset(c, g, "id", H5T_STD_U64LE, H5T_NATIVE_UINT64, n, 1, P->id))
+        goto out;
+    for (int e = 0; e < P->nextra; e++)
+        if (write_dataset(c, g, P->extra[e].name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 1,
+                          P->extra[e].v))
+            goto out;
+    close_id(&g, H5Gclose);
+
+    /* Vertex connectivity 0 .. N-1 for the XDMF Polyvertex topology: ParaView's Xdmf3
+     * readers make no cells without it, and points without cells do not show in the Points
+     * representation.  4 bytes per particle (8 beyond 2^32 particles). */
+    if ((g = make_group(c, f, "xdmf")) < 0) goto out;
+    if (n <= UINT32_MAX) {
+        uint32_t *v = c->buf;
+        for (size_t i = 0; i < n; i++) v[i] = (uint32_t)i;
+        if (write_dataset(c, g, "connectivity", H5T_STD_U32LE, H5T_NATIVE_UINT32, n, 1, v))
+            goto out;
+    } else {
+        int64_t *v = c->buf;
+        for (size_t i = 0; i < n; i++) v[i] = (int64_t)i;
+        if (write_dataset(c, g, "connectivity", H5T_STD_I64LE, H5T_NATIVE_INT64, n, 1, v)) goto out;
+    }
+    rc = 0;
+out:
+    close_id(&t, H5Tclose);
+    close_id(&g, H5Gclose);
+    return rc;
+}
+
+static void check_writable(const lub_particles *P)
+{
+    if (P->dim != 2 && P->dim != 3) lub_bug("dimension %d", P->dim);
+    if (P->nlevels < 1 || P->nlevels > LUB_MAX_LEVELS) lub_bug("nlevels %d", P->nlevels);
+    if (P->npatches < 0 || P->npatches > LUB_MAX_PATCHES) lub_bug("npatches %d", P->npatches);
+    if (P->nextra < 0 || P->nextra > LUB_MAX_EXTRA) lub_bug("nextra %d", P->nextra);
+    if (P->n > P->cap) lub_bug("n %zu > capacity %zu", P->n, P->cap);
+    /* What the reader rejects is never written: a bad kind, patch or level is a bug; a
+     * non-finite position is a failed run (the caller writes the last good state). */
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->kind[i] > LUB_DUMMY) lub_bug("particle %zu has kind %d", i, P->kind[i]);
+        if (P->level[i] >= P->nlevels)
+            lub_bug("particle %zu has level %d, nlevels %d", i, P->level[i], P->nlevels);
+        if (P->patch[i] >= P->npatches && !(P->kind[i] == LUB_FLUID && P->patch[i] == 0))
+            lub_bug("particle %zu has patch %d, npatches %d", i, P->patch[i], P->npatches);
+        for (int d = 0; d < 3; d++)
+            if (!isfinite(P->x[d][i]))
+                lub_fatal_run("particle %zu (id %llu) has a non-finite position; particles at "
+                              "time %g not written",
+                              i, (unsigned long long)P->id[i], P->time);
+        if (P->dim == 2 && P->x[2][i] != 0.0)
+            lub_bug("particle %zu has z = %g in 2-D", i, P->x[2][i]);
+    }
+}
+
+static void write_sidecar(const lub_particles *P, const char *dir);
+
+void lub_particles_write(const lub_particles *P, const char *dir)
+{
+    char path[LUB_PATH_MAX], tmp[LUB_PATH_MAX];
+    if (snprintf(path, sizeof path, "%s/particles.h5", dir) >= (int)sizeof path ||
+        snprintf(tmp, sizeof tmp, "%s/particles.h5.tmp%ld", dir, (long)getpid()) >= (int)sizeof tmp)
+        lub_fatal_run("path too long: '%s/particles.h5'", dir);
+    check_writable(P);
+
+    h5ctx c;
+    double *buf = lub_malloc(3 * (P->n ? P->n : 1) * sizeof *buf); /* before HDF5 is used */
+    ctx_begin(&c);
+    c.buf = buf;
+    if ((c.fapl = file_access_plist(1)) < 0)
+        fail_h5(&c, "cannot make a file access property list");
+    else if ((c.file = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, c.fapl)) < 0)
+        fail_h5(&c, "cannot create '%s'", tmp);
+    else
+        write_contents(&c, P);
+    if (!ctx_end(&c)) {
+        /* Flush to disk before the rename makes the file visible. */
+        int fd = open(tmp, O_RDONLY);
+        if (fd < 0 || fsync(fd) != 0) fail(&c, "cannot sync '%s': %s", tmp, strerror(errno));
+        if (fd >= 0) close(fd);
+        if (!c.failed && rename(tmp, path) != 0)
+            fail(&c, "cannot rename '%s': %s", tmp, strerror(errno));
+    }
+    if (c.failed) {
+        unlink(tmp);
+        lub_fatal_run("%s: cannot write particle file: %s", path, c.msg);
+    }
+    write_sidecar(P, dir);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* Reading                                                                                    */
+
+/* Read a scalar numeric attribute of object objname (for messages) into memtype. */
+static int read_attr_num(h5ctx *c, hid_t loc, const char *objname, const char *name, hid_t memtype,
+                         int integer_only, void *value)
+{
+    hid_t a = H5I_INVALID_HID, s = H5I_INVALID_HID, t = H5I_INVALID_HID;
+    int rc = -1;
+    htri_t ex = H5Aexists(loc, name);
+    if (ex < 0) {
+        fail_h5(c, "cannot read the attributes of %s", objname);
+        goto out;
+    }
+    if (ex == 0) {
+        fail(c, "attribute '%s' missing in %s", name, objname);
+        goto out;
+    }
+    if ((a = H5Aopen(loc, name, H5P_DEFAULT)) < 0 || (s = H5Aget_space(a)) < 0 ||
+        (t = H5Aget_type(a)) < 0) {
+        fail_h5(c, "cannot open attribute '%s' of %s", name, objname);
+        goto out;
+    }
+    H5T_class_t cls = H5Tget_class(t);
+    if (H5Sget_simple_extent_npoints(s) != 1) {
+        fail(c, "attribute '%s' of %s must be a single value", name, objname);
+        goto out;
+    }
+    if (cls != H5T_INTEGER && (integer_only || cls != H5T_FLOAT)) {
+        fail(c, "attribute '%s' of %s must be %s", name, objname,
+             integer_only ? "an integer" : "a number");
+        goto out;
+    }
+    if (H5Aread(a, memtype, value) < 0) {
+        fail_h5(c, "cannot read attribute '%s' of %s", name, objname);
+        goto out;
+    }
+    rc = 0;
+out:
+    close_id(&t, H5Tclose);
+    close_id(&s, H5Sclose);
+    close_id(&a, H5Aclose);
+    return rc;
+}
+
+static int read_attr_double(h5ctx *c, hid_t loc, const char *objname, const char *name, double *v)
+{
+    if (read_attr_num(c, loc, objname, name, H5T_NATIVE_DOUBLE, 0, v)) return -1;
+    if (!isfinite(*v)) return fail(c, "attribute '%s' of %s is not finite", name, objname);
+    return 0;
+}
+
+/* The format attribute: returns 0 when it is ours.  A file without it, or with another
+ * value, is "not a lubkit particle file". */
+static int check_format(h5ctx *c, hid_t f)
+{
+    hid_t a = H5I_INVALID_HID, t = H5I_INVALID_HID, m = H5I_INVALID_HID;
+    hid_t s = H5I_INVALID_HID;
+    char value[128] = "";
+    int rc = -1;
+    htri_t ex = H5Aexists(f, "format");
+    if (ex < 0) {
+        fail_h5(c, "cannot read the root attributes");
+        goto out;
+    }
+    if (ex == 0) {
+        fail(c, "not a lubkit particle file (format attribute missing)");
+        goto out;
+    }
+    if ((a = H5Aopen(f, "format", H5P_DEFAULT)) < 0 || (t = H5Aget_type(a)) < 0 ||
+        (s = H5Aget_space(a)) < 0) {
+        fail_h5(c, "cannot open the format attribute");
+        goto out;
+    }
+    if (H5Tget_class(t) != H5T_STRING || H5Sget_simple_extent_npoints(s) != 1) {
+        fail(c, "not a lubkit particle file (format attribute is not a string)");
+        goto out;
+    }
+    if (H5Tis_variable_str(t) > 0) {
+        char *v = NULL;
+        if ((m = H5Tcopy(H5T_C_S1)) < 0 || H5Tset_size(m, H5T_VARIABLE) < 0 ||
+            H5Aread(a, m, &v) < 0) {
+            fail_h5(c, "cannot read the format attribute");
+            goto out;
+        }
+        snprintf(value, sizeof value, "%s", v ? v : "");
+        H5free_memory(v);
+    } else {
+        size_t size = H5Tget_size(t);
+        if (size == 0 || size >= sizeof value) {
+            fail(c, "not a lubkit particle file (format attribute of %zu characters)", size);
+            goto out;
+        }
+        /* One byte more than stored, null-terminated: whatever the file's padding. */
+        if ((m = H5Tcopy(H5T_C_S1)) < 0 || H5Tset_size(m, size + 1) < 0 ||
+            H5Tset_strpad(m, H5T_STR_NULLTERM) < 0 || H5Aread(a, m, value) < 0) {
+            fail_h5(c, "cannot read the format attribute");
+            goto out;
+        }
+    }
+    if (strcmp(value, LUB_PARTICLES_FORMAT) != 0) {
+        fail(c, "not a lubkit particle file (format attribute is '%.64s', expected '%s')", value,
+             LUB_PARTICLES_FORMAT);
+        goto out;
+    }
+    rc = 0;
+out:
+    close_id(&m, H5Tclose);
+    close_id(&s, H5Sclose);
+    close_id(&t, H5Tclose);
+    close_id(&a, H5Aclose);
+    return rc;
+}
+
+/* Open dataset <gname>/<name>, check its class and shape (n_expected rows, or any when
+ * *n is (size_t)-1 on entry, then set; ncols 1 for rank 1).  Returns the open dataset. */
+static hid_t open_dataset(h5ctx *c, hid_t g, const char *gname, const char *name, int ncols,
+                          size_t *n, int want_float, int want_int)
+{
+    hid_t d = H5I_INVALID_HID, s = H5I_INVALID_HID, t = H5I_INVALID_HID;
+    htri_t ex = H5Lexists(g, name, H5P_DEFAULT);
+    if (ex < 0) {
+        fail_h5(c, "cannot look up %s/%s", gname, name);
+        goto bad;
+    }
+    if (ex == 0) {
+        fail(c, "dataset %s/%s missing", gname, name);
+        goto bad;
+    }
+    if ((d = H5Dopen2(g, name, H5P_DEFAULT)) < 0) {
+        fail_h5(c, "%s/%s is not a readable dataset", gname, name);
+        goto bad;
+    }
+    if ((s = H5Dget_space(d)) < 0 || (t = H5Dget_type(d)) < 0) {
+        fail_h5(c, "cannot read the shape of %s/%s", gname, name);
+        goto bad;
+    }
+    int rank = H5Sget_simple_extent_ndims(s);
+    hsize_t dims[H5S_MAX_RANK];
+    if (rank < 0 || H5Sget_simple_extent_dims(s, dims, NULL) < 0) {
+        fail_h5(c, "cannot read the shape of %s/%s", gname, name);
+        goto bad;
+    }
+    int want_rank = ncols > 1 ? 2 : 1;
+    if (rank != want_rank || (ncols > 1 && dims[1] != (hsize_t)ncols)) {
+        char shape[128] = "", *q = shape;
+        for (int k = 0; k < rank && q < shape + sizeof shape - 24; k++)
+            q += sprintf(q, "%s%llu", k ? " x " : "", (unsigned long long)dims[k]);
+        if (rank == 0) strcpy(shape, "scalar");
+        if (ncols > 1)
+            fail(c, "%s/%s has shape %s, expected N x %d", gname, name, shape, ncols);
+        else
+            fail(c, "%s/%s has shape %s, expected N (one value per particle)", gname, name, shape);
+        goto bad;
+    }
+    if (*n == (size_t)-1)
+        *n = (size_t)dims[0];
+    else if (dims[0] != (hsize_t)*n) {
+        fail(c, "%s/%s has %llu rows, expected %zu (the number of particles in position)", gname,
+             name, (unsigned long long)dims[0], *n);
+        goto bad;
+    }
+    H5T_class_t cls = H5Tget_class(t);
+    int ok = (want_float && cls == H5T_FLOAT) || (want_int && cls == H5T_INTEGER);
+    if (!ok) {
+        fail(c, "%s/%s must hold %s", gname, name,
+             want_float && want_int ? "numbers"
+             : want_float           ? "floating-point numbers"
+                                    : "integers");
+        goto bad;
+    }
+    close_id(&t, H5Tclose);
+    close_id(&s, H5Sclose);
+    return d;
+bad:
+    close_id(&t, H5Tclose);
+    close_id(&s, H5Sclose);
+    close_id(&d, H5Dclose);
+    return H5I_INVALID_HID;
+}
+
+/* Read a whole checked dataset into buf with memory type memtype. */
+static int read_dataset(h5ctx *c, hid_t g, const char *gname, const char *name, int ncols, size_t n,
+                        int want_float, int want_int, hid_t memtype, void *buf)
+{
+    size_t rows = n;
+    hid_t d = open_dataset(c, g, gname, name, ncols, &rows, want_float, want_int);
+    if (d < 0) return -1;
+    int rc = 0;
+    if (n > 0 && H5Dread(d, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)
+        rc = fail_h5(c, "cannot read %s/%s", gname, name);
+    H5Dclose(d);
+    return rc;
+}
+
+static int is_standard(const char *name)
+{
+    for (int k = 0; k < N_STANDARD; k++)
+        if (strcmp(name, standard_fields[k]) == 0) return 1;
+    return 0;
+}
+
+/* A name that lub_particles_extra accepts and that is safe in XML attributes. */
+static int name_ok(const char *s)
+{
+    size_t len = strlen(s);
+    if (len == 0 || len >= LUB_NAME_MAX) return 0;
+    for (; *s; s++)
+        if (*s == '/' || *s == '<' || *s == '>' || *s == '&' || *s == '"' || *s == '\'' ||
+            (unsigned char)*s < 32)
+            return 0;
+    return 1;
+}
+
+/* Header: format, root attributes, levels and patches (into P, not yet initialised). */
+static int read_header(h5ctx *c, hid_t f, lub_particles *P)
+{
+    int64_t step;
+    if (check_format(c, f) || read_attr_double(c, f, "/", "time", &P->time) ||
+        read_attr_num(c, f, "/", "step", H5T_NATIVE_INT64, 1, &step) ||
+        read_attr_num(c, f, "/", "dimension", H5T_NATIVE_INT, 1, &P->dim) ||
+        read_attr_num(c, f, "/", "nLevels", H5T_NATIVE_INT, 1, &P->nlevels))
+        return -1;
+    P->step = (long)step;
+    if (step < 0) return fail(c, "attribute 'step' is %lld, expected >= 0", (long long)step);
+    if (P->dim != 2 && P->dim != 3)
+        return fail(c, "attribute 'dimension' is %d, expected 2 or 3", P->dim);
+    if (P->nlevels < 1 || P->nlevels > LUB_MAX_LEVELS)
+        return fail(c, "attribute 'nLevels' is %d, expected 1 to %d", P->nlevels, LUB_MAX_LEVELS);
+    for (int k = 0; k < P->nlevels; k++) {
+        char name[32], objname[40];
+        lub_level *L = &P->levels[k];
+        snprintf(name, sizeof name, "level%d", k);
+        snprintf(objname, sizeof objname, "/%s", name);
+        htri_t ex = H5Lexists(f, name, H5P_DEFAULT);
+        if (ex <= 0) return fail(c, "group %s missing (nLevels is %d)", objname, P->nlevels);
+        hid_t g = H5Gopen2(f, name, H5P_DEFAULT);
+        if (g < 0) return fail_h5(c, "cannot open group %s", objname);
+        int rc = read_attr_double(c, g, objname, "l0", &L->l0) ||
+                 read_attr_double(c, g, objname, "re", &L->re) ||
+                 read_attr_double(c, g, objname, "n0", &L->n0) ||
+                 read_attr_double(c, g, objname, "lambda0", &L->lambda0);
+        H5Gclose(g);
+        if (rc) return -1;
+    }
+
+    /* /patches: 1-D strings, fixed or variable length. */
+    htri_t ex = H5Lexists(f, "patches", H5P_DEFAULT);
+    if (ex < 0) return fail_h5(c, "cannot look up /patches");
+    if (ex == 0) return fail(c, "dataset /patches missing");
+    hid_t d = H5Dopen2(f, "patches", H5P_DEFAULT);
+    if (d < 0) return fail_h5(c, "/patches is not a readable dataset");
+    hid_t t = H5Dget_type(d), s = H5Dget_space(d), m = H5I_INVALID_HID;
+    hsize_t dims[H5S_MAX_RANK];
+    int rc = -1;
+    char **vnames = NULL;
+    char *fnames = NULL;
+    if (t < 0 || s < 0) {
+        fail_h5(c, "cannot read the type of /patches");
+        goto out;
+    }
+    if (H5Tget_class(t) != H5T_STRING) {
+        fail(c, "/patches must hold strings (the patch names)");
+        goto out;
+    }
+    if (H5Sget_simple_extent_ndims(s) != 1 || H5Sget_simple_extent_dims(s, dims, NULL) < 0) {
+        fail(c, "/patches must be a 1-D list of names");
+        goto out;
+    }
+    if (dims[0] > LUB_MAX_PATCHES) {
+        fail(c, "/patches holds %llu names, at most %d are supported", (unsigned long long)dims[0],
+             LUB_MAX_PATCHES);
+        goto out;
+    }
+    P->npatches = (int)dims[0];
+    if (P->npatches > 0) {
+        if (H5Tis_variable_str(t) > 0) {
+            vnames = calloc((size_t)P->npatches, sizeof *vnames);
+            if (!vnames || (m = H5Tcopy(H5T_C_S1)) < 0 || H5Tset_size(m, H5T_VARIABLE) < 0 ||
+                H5Dread(d, m, H5S_ALL, H5S_ALL, H5P_DEFAULT, vnames) < 0) {
+                fail_h5(c, "cannot read /patches");
+                goto out;
+            }
+        } else {
+            size_t size = H5Tget_size(t) + 1;
+            fnames = calloc((size_t)P->npatches, size);
+            if (!fnames || (m = H5Tcopy(H5T_C_S1)) < 0 || H5Tset_size(m, size) < 0 ||
+                H5Tset_strpad(m, H5T_STR_NULLTERM) < 0 ||
+                H5Dread(d, m, H5S_ALL, H5S_ALL, H5P_DEFAULT, fnames) < 0) {
+                fail_h5(c, "cannot read /patches");
+                goto out;
+            }
+            for (int k = 0; k < P->npatches; k++) {
+                const char *name = fnames + (size_t)k * size;
+                if (strlen(name) >= LUB_NAME_MAX) {
+                    fail(c, "/patches[%d] '%.64s...' is longer than %d characters", k, name,
+                         LUB_NAME_MAX - 1);
+                    goto out;
+                }
+                strcpy(P->patch_names[k], name);
+            }
+        }
+        for (int k = 0; vnames && k < P->npatches; k++) {
+            const char *name = vnames[k] ? vnames[k] : "";
+            if (strlen(name) >= LUB_NAME_MAX) {
+                fail(c, "/patches[%d] '%.64s...' is longer than %d characters", k, name,
+                     LUB_NAME_MAX - 1);
+                goto out;
+            }
+            strcpy(P->patch_names[k], name);
+        }
+        for (int k = 0; k < P->npatches; k++) {
+            if (!name_ok(P->patch_names[k])) {
+                fail(c, "/patches[%d] '%s' is not a valid patch name", k, P->patch_names[k]);
+                goto out;
+            }
+            for (int j = 0; j < k; j++)
+                if (strcmp(P->patch_names[j], P->patch_names[k]) == 0) {
+                    fail(c, "/patches lists '%s' twice", P->patch_names[k]);
+                    goto out;
+                }
+        }
+    }
+    rc = 0;
+out:
+    if (vnames) {
+        if (m >= 0 && s >= 0) H5Dvlen_reclaim(m, s, H5P_DEFAULT, vnames);
+        free(vnames);
+    }
+    free(fnames);
+    close_id(&m, H5Tclose);
+    close_id(&s, H5Sclose);
+    close_id(&t, H5Tclose);
+    H5Dclose(d);
+    return rc;
+}
+
+/* Shape of /fields: N from position, and the extra fields (names checked, shapes N). */
+static int read_shape(h5ctx *c, hid_t g, size_t *n, int *nextra,
+                      char extra[LUB_MAX_EXTRA][LUB_NAME_MAX])
+{
+    *n = (size_t)-1;
+    hid_t d = open_dataset(c, g, "/fields", "position", 3, n, 1, 0);
+    if (d < 0) return -1;
+    H5Dclose(d);
+
+    H5G_info_t info;
+    if (H5Gget_info(g, &info) < 0) return fail_h5(c, "cannot list /fields");
+    *nextra = 0;
+    for (hsize_t k = 0; k < info.nlinks; k++) {
+        char name[LUB_NAME_MAX + 8];
+        ssize_t len = H5Lget_name_by_idx(g, ".", H5_INDEX_NAME, H5_ITER_INC, k, name, sizeof name,
+                                         H5P_DEFAULT);
+        if (len < 0) return fail_h5(c, "cannot list /fields");
+        if ((size_t)len >= LUB_NAME_MAX)
+            return fail(c, "/fields/%s...: field name longer than %d characters", name,
+                        LUB_NAME_MAX - 1);
+        if (is_standard(name)) continue;
+        if (!name_ok(name)) return fail(c, "/fields/%s: not a valid field name", name);
+        if (*nextra >= LUB_MAX_EXTRA)
+            return fail(c, "/fields holds more than %d extra fields", LUB_MAX_EXTRA);
+        size_t rows = *n;
+        d = open_dataset(c, g, "/fields", name, 1, &rows, 1, 1);
+        if (d < 0) return -1;
+        H5Dclose(d);
+        strcpy(extra[(*nextra)++], name);
+    }
+    return 0;
+}
+
+static int read_int_field(h5ctx *c, hid_t g, const char *name, size_t n, int64_t *tmp,
+                          int64_t limit, const char *expected)
+{
+    if (read_dataset(c, g, "/fields", name, 1, n, 0, 1, H5T_NATIVE_INT64, tmp)) return -1;
+    for (size_t i = 0; i < n; i++)
+        if (tmp[i] < 0 || tmp[i] >= limit)
+            return fail(c, "/fields/%s[%zu] = %lld, expected %s", name, i, (long long)tmp[i],
+                        expected);
+    return 0;
+}
+
+static int read_contents(h5ctx *c, lub_particles *P)
+{
+    hid_t f = c->file;
+    lub_particles H;
+    memset(&H, 0, sizeof H);
+    if (read_header(c, f, &H)) return -1;
+
+    hid_t g = H5I_INVALID_HID;
+    int rc = -1;
+    htri_t ex = H5Lexists(f, "fields", H5P_DEFAULT);
+    if (ex <= 0) {
+        fail(c, "group /fields missing");
+        goto out;
+    }
+    if ((g = H5Gopen2(f, "fields", H5P_DEFAULT)) < 0) {
+        fail_h5(c, "cannot open group /fields");
+        goto out;
+    }
+    size_t n;
+    int nextra;
+    char extra[LUB_MAX_EXTRA][LUB_NAME_MAX];
+    if (read_shape(c, g, &n, &nextra, extra)) goto out;
+    if (n > ((size_t)-1) / (3 * sizeof(double)) - 1) {
+        fail(c, "/fields/position claims %zu particles", n);
+        goto out;
+    }
+
+    /* The header is sound: set up storage (n exactly) and read the data. */
+    lub_particles_init(P, H.dim, n ? n : 1);
+    c->have_data = 1;
+    P->time = H.time;
+    P->step = H.step;
+    P->nlevels = H.nlevels;
+    memcpy(P->levels, H.levels, sizeof P->levels);
+    P->npatches = H.npatches;
+    memcpy(P->patch_names, H.patch_names, sizeof P->patch_names);
+    P->n = n;
+    for (int e = 0; e < nextra; e++) lub_particles_extra(P, extra[e]); /* names checked */
+
+    c->buf = malloc(3 * (n ? n : 1) * sizeof(double));
+    if (!c->buf) {
+        fail(c, "out of memory reading %zu particles", n);
+        goto out;
+    }
+    double *buf = c->buf;
+    int64_t *tmp = c->buf;
+
+    if (read_dataset(c, g, "/fields", "position", 3, n, 1, 0, H5T_NATIVE_DOUBLE, buf)) goto out;
+    for (size_t i = 0; i < n; i++)
+        for (int d = 0; d < 3; d++) {
+            double v = buf[3 * i + d];
+            if (!isfinite(v)) {
+                fail(c, "/fields/position[%zu][%d] is not finite (%g)", i, d, v);
+                goto out;
+            }
+            if (d == 2 && P->dim == 2 && v != 0.0) {
+                fail(c, "/fields/position[%zu] has z = %g in a 2-D file (expected 0)", i, v);
+                goto out;
+            }
+            P->x[d][i] = v;
+        }
+    if (read_dataset(c, g, "/fields", "velocity", 3, n, 1, 0, H5T_NATIVE_DOUBLE, buf)) goto out;
+    for (size_t i = 0; i < n; i++)
+        for (int d = 0; d < 3; d++) P->u[d][i] = buf[3 * i + d];
+    if (read_dataset(c, g, "/fields", "pressure", 1, n, 1, 0, H5T_NATIVE_DOUBLE, P->p) ||
+        read_dataset(c, g, "/fields", "id", 1, n, 0, 1, H5T_NATIVE_UINT64, P->id))
+        goto out;
+    for (int e = 0; e < P->nextra; e++)
+        if (read_dataset(c, g, "/fields", P->extra[e].name, 1, n, 1, 1, H5T_NATIVE_DOUBLE,
+                         P->extra[e].v))
+            goto out;
+
+    if (read_int_field(c, g, "kind", n, tmp, 3, "0 (fluid), 1 (wall) or 2 (dummy)")) goto out;
+    for (size_t i = 0; i < n; i++) P->kind[i] = (uint8_t)tmp[i];
+    char expected[96];
+    snprintf(expected, sizeof expected, "a level below nLevels = %d", P->nlevels);
+    if (read_int_field(c, g, "level", n, tmp, P->nlevels, expected)) goto out;
+    for (size_t i = 0; i < n; i++) P->level[i] = (uint8_t)tmp[i];
+    /* Fluid particles carry patch 0, meaningless; walls and dummies name a patch. */
+    if (read_int_field(c, g, "patch", n, tmp, 65536, "0 to 65535")) goto out;
+    for (size_t i = 0; i < n; i++) {
+        if (tmp[i] >= P->npatches && !(P->kind[i] == LUB_FLUID && tmp[i] == 0)) {
+            fail(c, "/fields/patch[%zu] = %lld, but /patches lists %d name%s", i, (long long)tmp[i],
+                 P->npatches, P->npatches == 1 ? "" : "s");
+            goto out;
+        }
+        P->patch[i] = (uint16_t)tmp[i];
+    }
+    rc = 0;
+out:
+    close_id(&g, H5Gclose);
+    return rc;
+}
+
+/* Common opening of a file for reading; returns 0 with c->file open. */
+static int open_for_reading(h5ctx *c, const char *path)
+{
+    struct stat st;
+    if (stat(path, &st) != 0) return fail(c, "cannot read particle file: %s", strerror(errno));
+    if (!S_ISREG(st.st_mode)) return fail(c, "not a regular file");
+    htri_t is = H5Fis_hdf5(path);
+    if (is == 0) return fail(c, "not an HDF5 file (a lubkit particle file is HDF5)");
+    if (is < 0) return fail_h5(c, "not a readable HDF5 file");
+    if ((c->fapl = file_access_plist(0)) < 0)
+        return fail_h5(c, "cannot make a file access property list");
+    if ((c->file = H5Fopen(path, H5F_ACC_RDONLY, c->fapl)) < 0)
+        return fail_h5(c, "damaged or unreadable HDF5 file");
+    return 0;
+}
+
+void lub_particles_read(lub_particles *P, const char *path)
+{
+    h5ctx c;
+    memset(P, 0, sizeof *P);
+    ctx_begin(&c);
+    if (open_for_reading(&c, path) == 0) read_contents(&c, P);
+    int have_data = c.have_data;
+    if (ctx_end(&c)) {
+        if (have_data) lub_particles_free(P);
+        lub_fatal("%s: %s", path, c.msg);
+    }
+}
+
+/* Size of the entries of /xdmf/connectivity when it is a list of n integers, else 0 (the
+ * XDMF then has no connectivity: fine for the Xdmf2 reader, points only for Xdmf3). */
+static int connectivity_bytes(hid_t f, size_t n)
+{
+    int bytes = 0;
+    if (H5Lexists(f, "xdmf", H5P_DEFAULT) <= 0 ||
+        H5Lexists(f, "xdmf/connectivity", H5P_DEFAULT) <= 0)
+        return 0;
+    hid_t d = H5Dopen2(f, "xdmf/connectivity", H5P_DEFAULT);
+    if (d < 0) return 0;
+    hid_t s = H5Dget_space(d), t = H5Dget_type(d);
+    hsize_t dims[H5S_MAX_RANK];
+    if (s >= 0 && t >= 0 && H5Sget_simple_extent_ndims(s) == 1 &&
+        H5Sget_simple_extent_dims(s, dims, NULL) == 1 && dims[0] == (hsize_t)n &&
+        H5Tget_class(t) == H5T_INTEGER) {
+        size_t size = H5Tget_size(t);
+        H5T_sign_t sign = H5Tget_sign(t);
+        if (size == 4 && sign == H5T_SGN_NONE) bytes = 4;
+        if (size == 8 && sign == H5T_SGN_2) bytes = 8;
+    }
+    close_id(&t, H5Tclose);
+    close_id(&s, H5Sclose);
+    H5Dclose(d);
+    H5Eclear2(H5E_DEFAULT);
+    return bytes;
+}
+
+/* Header and shapes of a file; 0, or -1 with the reason in msg. */
+static int read_info(const char *path, lub_particles_info *info, char *msg, size_t size)
+{
+    h5ctx c;
+    lub_particles H;
+    memset(&H, 0, sizeof H);
+    memset(info, 0, sizeof *info);
+    ctx_begin(&c);
+    if (open_for_reading(&c, path) == 0 && read_header(&c, c.file, &H) == 0) {
+        hid_t g = H5I_INVALID_HID;
+        if (H5Lexists(c.file, "fields", H5P_DEFAULT) <= 0)
+            fail(&c, "group /fields missing");
+        else if ((g = H5Gopen2(c.file, "fields", H5P_DEFAULT)) < 0)
+            fail_h5(&c, "cannot open group /fields");
+        else if (read_shape(&c, g, &info->n, &info->nextra, info->extra) == 0)
+            info->conn_bytes = connectivity_bytes(c.file, info->n);
+        close_id(&g, H5Gclose);
+    }
+    if (ctx_end(&c)) {
+        snprintf(msg, size, "%s: %s", path, c.msg);
+        return -1;
+    }
+    info->dim = H.dim;
+    info->time = H.time;
+    info->step = H.step;
+    info->nlevels = H.nlevels;
+    info->npatches = H.npatches;
+    return 0;
+}
+
+void lub_particles_read_info(const char *path, lub_particles_info *info)
+{
+    char msg[LUB_PATH_MAX + 1100];
+    if (read_info(path, info, msg, sizeof msg)) lub_fatal("%s", msg);
+}
+
+/* ------------------------------------------------------------------------------------------ */
+/* XDMF                                                                                       */
+
+/* One DataItem referring to <prefix>particles.h5:/fields/<name>. */
+static void xdmf_item(FILE *fp, const char *indent, const char *prefix, const char *name, size_t n,
+                      int ncols, const char *numtype, int precision)
+{
+    char dims[64];
+    if (ncols > 1)
+        snprintf(dims, sizeof dims, "%zu %d", n, ncols);
+    else
+        snprintf(dims, sizeof dims, "%zu", n);
+    fprintf(fp,
+            "%s<DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"%d\" "
+            "Format=\"HDF\">%sparticles.h5:/fields/%s</DataItem>\n",
+            indent, dims, numtype, precision, prefix, name);
+}
+
+static void xdmf_attribute(FILE *fp, const char *indent, const char *prefix, const char *name,
+                           size_t n, int ncols, const char *numtype, int precision)
+{
+    char inner[32];
+    snprintf(inner, sizeof inner, "%s  ", indent);
+    fprintf(fp, "%s<Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n", indent, name,
+            ncols > 1 ? "Vector" : "Scalar");
+    xdmf_item(fp, inner, prefix, name, n, ncols, numtype, precision);
+    fprintf(fp, "%s</Attribute>\n", indent);
+}
+
+/* One uniform grid of n points: a Polyvertex topology whose connectivity (written by
+ * lub_particles_write, conn_bytes per entry) is 0 .. n-1, so every particle is one vertex
+ * cell; without it (conn_bytes 0, a foreign file) Xdmf3 readers show points but no cells.
+ * The id (uint64 in the file) is described as Int 8 because ParaView's Xdmf3 reader has no
+ * 64-bit unsigned array type and skips such arrays; HDF5 converts on reading, exact for ids
+ * below 2^63. */
+static void xdmf_grid(FILE *fp, const char *indent, const char *name, double time,
+                      const char *prefix, size_t n, int conn_bytes, int nextra,
+                      const char extra[][LUB_NAME_MAX])
+{
+    char in1[32], in2[32];
+    snprintf(in1, sizeof in1, "%s  ", indent);
+    snprintf(in2, sizeof in2, "%s    ", indent);
+    fprintf(fp, "%s<Grid Name=\"%s\" GridType=\"Uniform\">\n", indent, name);
+    fprintf(fp, "%s<Time Value=\"%.17g\"/>\n", in1, time);
+    fprintf(fp,
+            "%s<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
+            "NodesPerElement=\"1\"%s>\n",
+            in1, n, conn_bytes ? "" : "/");
+    if (conn_bytes) {
+        fprintf(fp,
+                "%s<DataItem Dimensions=\"%zu\" NumberType=\"%s\" Precision=\"%d\" "
+                "Format=\"HDF\">%sparticles.h5:/xdmf/connectivity</DataItem>\n",
+                in2, n, conn_bytes == 4 ? "UInt" : "Int", conn_bytes, prefix);
+        fprintf(fp, "%s</Topology>\n", in1);
+    }
+    fprintf(fp, "%s<Geometry GeometryType=\"XYZ\">\n", in1);
+    xdmf_item(fp, in2, prefix, "position", n, 3, "Float", 8);
+    fprintf(fp, "%s</Geometry>\n", in1);
+    xdmf_attribute(fp, in1, prefix, "velocity", n, 3, "Float", 8);
+    xdmf_attribute(fp, in1, prefix, "pressure", n, 1, "Float", 8);
+    xdmf_attribute(fp, in1, prefix, "kind", n, 1, "UChar", 1);
+    xdmf_attribute(fp, in1, prefix, "patch", n, 1, "UInt", 2);
+    xdmf_attribute(fp, in1, prefix, "level", n, 1, "UChar", 1);
+    xdmf_attribute(fp, in1, prefix, "id", n, 1, "Int", 8);
+    for (int e = 0; e < nextra; e++) xdmf_attribute(fp, in1, prefix, extra[e], n, 1, "Float", 8);
+    fprintf(fp, "%s</Grid>\n", indent);
+}
+
+static void xdmf_head(FILE *fp)
+{
+    fprintf(fp, "<?xml version=\"1.0\" encoding=\"utf-8\"?>\n"
+                "<Xdmf xmlns:xi=\"http://www.w3.org/2001/XInclude\" Version=\"3.0\">\n"
+                "  <Domain>\n");
+}
+
+static void xdmf_tail(FILE *fp)
+{
+    fprintf(fp, "  </Domain>\n</Xdmf>\n");
+}
+
+static void write_sidecar(const lub_particles *P, const char *dir)
+{
+    char path[LUB_PATH_MAX];
+    char extra[LUB_MAX_EXTRA][LUB_NAME_MAX];
+    if (snprintf(path, sizeof path, "%s/particles.xdmf", dir) >= (int)sizeof path)
+        lub_fatal_run("path too long: '%s/particles.xdmf'", dir);
+    for (int e = 0; e < P->nextra; e++) strcpy(extra[e], P->extra[e].name);
+    lub_atomic_file af;
+    FILE *fp = lub_atomic_open(&af, path);
+    if (!fp) lub_fatal_run("%s: cannot write: %s", path, strerror(errno));
+    xdmf_head(fp);
+    xdmf_grid(fp, "    ", "particles", P->time, "", P->n, P->n <= UINT32_MAX ? 4 : 8, P->nextra,
+              (const char(*)[LUB_NAME_MAX])extra);
+    xdmf_tail(fp);
+    if (lub_atomic_close(&af) != 0) lub_fatal_run("%s: cannot write: %s", path, strerror(errno));
+}
+
+size_t lub_case_xdmf_write(const lub_case *c)
+{
+    lub_time *times = NULL;
+    size_t nt = lub_case_times(c, &times), listed = 0;
+    char path[LUB_PATH_MAX];
+    lub_case_path(c, path, "particles.xdmf");
+    lub_atomic_file af;
+    FILE *fp = NULL;
+    for (size_t k = 0; k < nt; k++) {
+        char h5[LUB_PATH_MAX], prefix[80];
+        struct stat st;
+        lub_case_pathf(c, h5, "%s/particles.h5", times[k].name);
+        if (stat(h5, &st) != 0) continue;
+        lub_particles_info info;
+        char msg[LUB_PATH_MAX + 1100];
+        if (read_info(h5, &info, msg, sizeof msg)) {
+            lub_warning("%s (time %s left out of %s)", msg, times[k].name, path);
+            continue;
+        }
+        if (!fp) {
+            if (!(fp = lub_atomic_open(&af, path))) {
+                free(times);
+                lub_fatal_run("%s: cannot write: %s", path, strerror(errno));
+            }
+            xdmf_head(fp);
+            fprintf(fp, "    <Grid Name=\"particles\" GridType=\"Collection\" "
+                        "CollectionType=\"Temporal\">\n");
+        }
+        snprintf(prefix, sizeof prefix, "%s/", times[k].name);
+        xdmf_grid(fp, "      ", times[k].name, times[k].value, prefix, info.n, info.conn_bytes,
+                  info.nextra, (const char(*)[LUB_NAME_MAX])info.extra);
+        listed++;
+    }
+    free(times);
+    if (!fp) {
+        unlink(path); /* no particles any more: an old collection would be stale */
+        return 0;
+    }
+    fprintf(fp, "    </Grid>\n");
+    xdmf_tail(fp);
+    if (lub_atomic_close(&af) != 0) lub_fatal_run("%s: cannot write: %s", path, strerror(errno));
+    return listed;
+}

@@ -1,0 +1,709 @@
+/* Unit tests of src/geometry: the particleGenDict reader, the analytic wall functions and
+ * the discretisation into wall, dummy and fluid particles.  Expected values are computed by
+ * hand from the geometry (counts of lattice points, circle arithmetic). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "geometry/discretise.h"
+#include "geometry/geometry.h"
+#include "test.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+static char tmp_path[256];
+
+/* Write a dictionary to a temporary file and return its path. */
+static const char *dict_file(const char *text)
+{
+    snprintf(tmp_path, sizeof tmp_path, "/tmp/lub_geometry_test_%ld.yaml", (long)getpid());
+    FILE *f = fopen(tmp_path, "w");
+    fputs(text, f);
+    fclose(f);
+    return tmp_path;
+}
+
+static void read_text(lub_geometry *g, const char *text)
+{
+    lub_geometry_read(g, dict_file(text));
+}
+
+/* Expect a fatal error mentioning sub and the line number `line` of the temp file. */
+#define CHECK_BAD(text, line, sub)                                                                 \
+    do {                                                                                           \
+        lub_geometry g_;                                                                           \
+        memset(&g_, 0, sizeof g_);                                                                 \
+        const char *p_ = dict_file(text);                                                          \
+        CHECK_FATAL(lub_geometry_read(&g_, p_), sub);                                              \
+        char loc_[300];                                                                            \
+        snprintf(loc_, sizeof loc_, "%s:%d:", p_, line);                                           \
+        CHECK_STR(test_last_error, loc_);                                                          \
+        lub_geometry_free(&g_);                                                                    \
+    } while (0)
+
+static const char *wedge_text = "dimension: 2\n"
+                                "l0: 5.0e-6\n"
+                                "domain: { min: [-0.0045, -2.0e-5], max: [0.0045, 3.0e-4] }\n"
+                                "periodic: [x]\n"
+                                "walls:\n"
+                                "  lowerWall: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+                                "  cylinder: { type: cylinder, lowestPoint: [0, 4.0e-5], "
+                                "radius: 0.04, range: [-0.0045, 0.0045] }\n"
+                                "fluid:\n"
+                                "  - { type: layer, wall: lowerWall, thickness: 8.0e-5 }\n";
+
+static void test_read_wedge(void)
+{
+    lub_geometry g;
+    read_text(&g, wedge_text);
+    CHECK(g.dim == 2);
+    CHECK(g.nlevels == 1);
+    CHECK_NEAR(g.levels[0].l0, 5e-6, 0);
+    CHECK(g.periodic[0] == 1 && g.periodic[1] == 0);
+    CHECK(g.dummy_layers == 2);
+    CHECK_NEAR(g.wall_gap, 1.0, 0);
+    CHECK(g.nwalls == 2);
+    CHECK(lub_geometry_find_wall(&g, "cylinder") == 1);
+    CHECK(lub_geometry_find_wall(&g, "nothing") == -1);
+    const lub_wall *c = &g.walls[1];
+    CHECK(c->type == LUB_WALL_CYLINDER);
+    CHECK_NEAR(c->centre[1], 0.04 + 4e-5, 1e-15);
+    CHECK(c->has_range);
+    CHECK(g.nregions == 1 && g.regions[0].type == LUB_REGION_LAYER && g.regions[0].wall == 0);
+    lub_geometry_free(&g);
+}
+
+/* Heights and distances against hand-computed values. */
+static void test_wall_functions(void)
+{
+    lub_geometry g;
+    read_text(&g, "dimension: 2\nl0: 0.1\ndomain: { min: [-3, -3], max: [3, 3] }\n"
+                  "walls:\n"
+                  "  p:  { type: plane, point: [0, 1], normal: [-1, 1] }\n"
+                  "  s:  { type: segment, from: [2, 1], to: [0, 0], fluid: below }\n"
+                  "  c:  { type: cylinder, centre: [0, 2], radius: 1 }\n"
+                  "  pl: { type: polyline, points: [[0, 0], [1, 1], [2, 0]] }\n"
+                  "  b:  { type: box, min: [-1, -1], max: [1, 0.5] }\n");
+    double y;
+    const lub_wall *p = &g.walls[0], *s = &g.walls[1], *c = &g.walls[2], *pl = &g.walls[3],
+                   *b = &g.walls[4];
+    /* plane y = 1 + x */
+    CHECK(lub_wall_height(p, 2.0, 0, &y) && fabs(y - 3.0) < 1e-14);
+    CHECK_NEAR(lub_wall_distance(p, (double[]){0, 2}, 2), 1 / sqrt(2.0), 1e-14);
+    CHECK_NEAR(lub_wall_distance(p, (double[]){0, 0}, 2), -1 / sqrt(2.0), 1e-14);
+    /* segment y = x/2 on [0, 2], fluid below */
+    CHECK(lub_wall_height(s, 1.0, 1, &y) && fabs(y - 0.5) < 1e-14);
+    CHECK(!lub_wall_height(s, 2.5, 1, &y));
+    CHECK_NEAR(lub_wall_distance(s, (double[]){1, -0.5}, 2), 2 / sqrt(5.0), 1e-14);
+    /* beyond the end: distance to (2, 1), above the extended line -> solid side */
+    CHECK_NEAR(lub_wall_distance(s, (double[]){3, 2}, 2), -sqrt(2.0), 1e-14);
+    /* circle centre (0, 2), R = 1: upper wall of a gap -> lowest point 2 - sqrt(1 - x^2) */
+    CHECK(lub_wall_height(c, 0.6, 1, &y) && fabs(y - 1.2) < 1e-14);
+    CHECK(lub_wall_height(c, 0.6, 0, &y) && fabs(y - 2.8) < 1e-14);
+    CHECK(!lub_wall_height(c, 1.5, 1, &y));
+    CHECK_NEAR(lub_wall_distance(c, (double[]){0, 0}, 2), 1.0, 1e-14);
+    CHECK_NEAR(lub_wall_distance(c, (double[]){0, 2.5}, 2), -0.5, 1e-14);
+    /* polyline tent */
+    CHECK(lub_wall_height(pl, 1.5, 0, &y) && fabs(y - 0.5) < 1e-14);
+    CHECK_NEAR(lub_wall_distance(pl, (double[]){1, 2}, 2), 1.0, 1e-14);
+    CHECK_NEAR(lub_wall_distance(pl, (double[]){1, 0}, 2), -1 / sqrt(2.0), 1e-14);
+    /* box tank (fluid inside): floor is the lower wall, lid the upper */
+    CHECK(lub_wall_height(b, 0, 0, &y) && y == -1.0);
+    CHECK(lub_wall_height(b, 0, 1, &y) && y == 0.5);
+    CHECK_NEAR(lub_wall_distance(b, (double[]){0, 0}, 2), 0.5, 1e-14);
+    CHECK_NEAR(lub_wall_distance(b, (double[]){2, 1.5}, 2), -sqrt(2.0), 1e-14);
+    lub_geometry_free(&g);
+}
+
+static void test_wall_functions_3d(void)
+{
+    lub_geometry g;
+    read_text(&g, "dimension: 3\nl0: 0.1\ndomain: { min: [-3, -3, -3], max: [3, 3, 3] }\n"
+                  "walls:\n"
+                  "  ball:  { type: sphere, centre: [0, 2, 0.6], radius: 1 }\n"
+                  "  shaft: { type: cylinder, centre: [0, 0, 0], axis: [1, 0, 0], radius: 0.5 }\n"
+                  "  floor: { type: plane, point: [0, -1, 0], normal: [0, 1, 0] }\n");
+    double y;
+    /* z = 0 section of the sphere: circle of radius 0.8 around (0, 2) */
+    CHECK(lub_wall_height(&g.walls[0], 0, 1, &y) && fabs(y - 1.2) < 1e-14);
+    CHECK_NEAR(lub_wall_distance(&g.walls[0], (double[]){0, 2, 0.6}, 3), -1.0, 1e-14);
+    /* cylinder along x: its section at any x is y = -0.5 (lower surface) */
+    CHECK(lub_wall_height(&g.walls[1], 2.0, 1, &y) && fabs(y + 0.5) < 1e-14);
+    CHECK_NEAR(lub_wall_distance(&g.walls[1], (double[]){7, 0, 1.5}, 3), 1.0, 1e-14);
+    CHECK(lub_wall_height(&g.walls[2], 1.0, 0, &y) && fabs(y + 1.0) < 1e-14);
+    lub_geometry_free(&g);
+}
+
+static void test_read_levels(void)
+{
+    lub_geometry g;
+    read_text(&g, "dimension: 2\n"
+                  "levels:\n"
+                  "  - { l0: 5.0e-6, region: [-0.0036, 0.0030] }\n"
+                  "  - { l0: 4.0e-5 }\n"
+                  "domain: { min: [-0.0048, -4.0e-5], max: [0.0048, 3.0e-4] }\n"
+                  "periodic: [x]\n"
+                  "walls:\n"
+                  "  lowerWall: { type: plane, point: [0, 0], normal: [0, 1] }\n");
+    CHECK(g.nlevels == 2);
+    CHECK(g.levels[0].has_region && g.levels[0].xmin == -0.0036 && g.levels[0].xmax == 0.0030);
+    CHECK(!g.levels[1].has_region && g.levels[1].xmin == -0.0048);
+    lub_geometry_free(&g);
+}
+
+/* Every bad-input class: exit-1 fatal with file:line of the offending entry. */
+static void test_bad_input(void)
+{
+    CHECK_BAD("dimension: 2\nl0: -1e-6\ndomain: { min: [0, 0], max: [1, 1] }\n", 2,
+              "'l0' must be > 0");
+    CHECK_BAD("dimension: 2\nl0: 0\ndomain: { min: [0, 0], max: [1, 1] }\n", 2, "'l0' must be > 0");
+    CHECK_BAD("dimension: 4\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\n", 1,
+              "'dimension' must be between 2 and 3");
+    CHECK_BAD("dimension: 2\nl0: 0.1\ndomain: { min: [0, 2], max: [1, 1] }\n", 3,
+              "min must be below max");
+    CHECK_BAD("dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\n"
+              "walls:\n  lowerWall: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+              "fluid:\n  - { type: layer, wall: lowerWal, thickness: 0.5 }\n",
+              7, "unknown wall 'lowerWal' (did you mean 'lowerWall'?)");
+    CHECK_BAD("dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\n"
+              "walls:\n  a: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+              "  b: { type: cylinder, centre: [0, 0], radius: 1 }\n"
+              "fluid:\n  - { type: between, lower: a, upper: cylindr, height: 0.5 }\n",
+              8, "unknown wall 'cylindr'");
+    CHECK_BAD("dimension: 2\nlevels:\n  - { l0: 0.1, region: [0, 0.5] }\n"
+              "  - { l0: 0.2, region: [0.5, 0.8] }\n"
+              "domain: { min: [0, 0], max: [1, 1] }\n",
+              3, "do not cover the domain: x from 0.8");
+    CHECK_BAD("dimension: 2\nlevels:\n  - { l0: 0.1 }\n  - { l0: 0.2 }\n"
+              "domain: { min: [0, 0], max: [1, 1] }\n",
+              3, "needs 'region");
+    CHECK_BAD("dimension: 2\nlevels:\n  - { l0: 0.2, region: [0, 0.5] }\n  - { l0: 0.1 }\n"
+              "domain: { min: [0, 0], max: [1, 1] }\n",
+              4, "from fine to coarse");
+    CHECK_BAD("dimension: 2\nl0: 0.3\ndomain: { min: [0, 0], max: [1, 1] }\nperiodic: [x]\n", 4,
+              "not a multiple of l0 = 0.3");
+    CHECK_BAD("dimension: 2\nlevels:\n  - { l0: 0.1, region: [0, 0.5] }\n  - { l0: 0.3 }\n"
+              "domain: { min: [0, 0], max: [1.0, 1] }\nperiodic: [x]\n",
+              6, "not a multiple of l0 = 0.3");
+    CHECK_BAD("dimension: 2\nlevels:\n  - { l0: 0.1, region: [0, 0.5] }\n  - { l0: 0.25 }\n"
+              "domain: { min: [0, 0], max: [1.2, 1] }\nperiodic: [x]\n",
+              6, "not a multiple of l0 = 0.25");
+    CHECK_BAD("dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\nwalls:\n"
+              "  p: { type: polyline, points: [[0, 0], [0.5, 1], [0.5, 0]] }\n",
+              5, "x must increase");
+    CHECK_BAD("dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\nwalls:\n"
+              "  c: { type: cylinder, centre: [0, 0],\n        radius: 0 }\n",
+              6, "'walls.c.radius' must be > 0");
+    CHECK_BAD("dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\nwalls:\n"
+              "  c: { type: cylinder, centre: [0, 0], radius: -2 }\n",
+              5, "must be > 0");
+    CHECK_BAD("dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\n"
+              "fluid:\n  - { type: box, min: [0.2, 0.2], max: [1.5, 0.5] }\n",
+              5, "outside the domain");
+    CHECK_BAD("dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\nwalls:\n"
+              "  p: { type: plane, point: [0, 0], normal: [0, 1], nromal: [0, 1] }\n",
+              5, "unknown key 'nromal'");
+    CHECK_BAD("dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\nwalls:\n"
+              "  p: { type: plan, point: [0, 0], normal: [0, 1] }\n",
+              5, "did you mean 'plane'");
+    CHECK_BAD("dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\nwalls:\n"
+              "  p: { type: plane, point: [0, 0], normal: [0, 0] }\n",
+              5, "non-zero vector");
+    CHECK_BAD("dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\nwalls:\n"
+              "  s: { type: sphere, centre: [0, 0], radius: 1 }\n",
+              5, "3-D only");
+    CHECK_BAD("dimension: 2\nl0: 0.1\nlevels: [ { l0: 0.1 } ]\n"
+              "domain: { min: [0, 0], max: [1, 1] }\n",
+              3, "not both");
+    CHECK_BAD("dimension: 2\ndomain: { min: [0, 0], max: [1, 1] }\n", 1,
+              "missing required key 'l0'");
+    CHECK_BAD("dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\nperiodic: [q]\n", 4,
+              "found 'q'");
+}
+
+/* ---- discretisation ------------------------------------------------------------------- */
+
+static size_t count_of(const lub_particles *P, int kind, int level)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < P->n; i++)
+        if (P->kind[i] == kind && (level < 0 || P->level[i] == level)) n++;
+    return n;
+}
+
+static void generate(const char *text, lub_geometry *g, lub_particles *P, size_t *rc)
+{
+    read_text(g, text);
+    lub_geometry_discretise(g, P, 0.0, rc);
+}
+
+/* Square-lattice n0 of (T-4) by hand: the shells of a 2-D lattice inside re = 3.1 l0 are
+ * r/l0 = 1 (4 points), sqrt2 (4), 2 (4), sqrt5 (8), sqrt8 (4), 3 (4); sqrt10 > 3.1. */
+static double n0_2d_by_shells(double *lambda0_over_l0sq)
+{
+    const double r[] = {1, sqrt(2.0), 2, sqrt(5.0), sqrt(8.0), 3};
+    const int m[] = {4, 4, 4, 8, 4, 4};
+    double n0 = 0, num = 0;
+    for (int i = 0; i < 6; i++) {
+        double w = (1 - r[i] / 3.1) * (1 - r[i] / 3.1);
+        n0 += m[i] * w;
+        num += m[i] * w * r[i] * r[i];
+    }
+    *lambda0_over_l0sq = num / n0;
+    return n0;
+}
+
+/* A plane with a layer, periodic in x: 10 columns of l0 = 0.1, wall at y = 0, dummies at
+ * -0.1 and -0.2, fluid rows 0.1 .. 0.5. */
+static void test_plane_layer(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    size_t rc[1];
+    generate("dimension: 2\nl0: 0.1\ndomain: { min: [0, -0.3], max: [1, 1] }\n"
+             "periodic: [x]\n"
+             "walls:\n  floor: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+             "fluid:\n  - { type: layer, wall: floor, thickness: 0.5 }\n",
+             &g, &P, rc);
+    CHECK(count_of(&P, LUB_WALL, -1) == 10);
+    CHECK(count_of(&P, LUB_DUMMY, -1) == 20);
+    CHECK(count_of(&P, LUB_FLUID, -1) == 50);
+    CHECK(rc[0] == 50);
+    CHECK(P.npatches == 1 && strcmp(P.patch_names[0], "floor") == 0);
+    double xmin = 1, xmax = 0;
+    int bad = 0;
+    for (size_t i = 0; i < P.n; i++) {
+        double x = P.x[0][i], y = P.x[1][i];
+        xmin = fmin(xmin, x), xmax = fmax(xmax, x);
+        /* cell-centred in x, on the rows k l0 in y */
+        double qx = (x - 0.05) / 0.1, qy = y / 0.1;
+        if (fabs(qx - round(qx)) > 1e-9 || fabs(qy - round(qy)) > 1e-9) bad++;
+        if (P.kind[i] == LUB_WALL && fabs(y) > 1e-12) bad++;
+        if (P.kind[i] == LUB_DUMMY && !(fabs(y + 0.1) < 1e-12 || fabs(y + 0.2) < 1e-12)) bad++;
+        if (P.kind[i] == LUB_FLUID && !(y > 0.05 && y < 0.55)) bad++;
+        if (P.x[2][i] != 0.0) bad++;
+    }
+    CHECK(bad == 0);
+    /* periodic seam: first column at min + l0/2, last at max - l0/2: l0 apart across it */
+    CHECK_NEAR(xmin, 0.05, 1e-12);
+    CHECK_NEAR(xmax, 0.95, 1e-12);
+    CHECK_NEAR(1.0 - xmax + xmin, 0.1, 1e-12);
+    double l0sq;
+    double n0 = n0_2d_by_shells(&l0sq);
+    CHECK(P.nlevels == 1);
+    CHECK_REL(P.levels[0].re, 0.31, 1e-14);
+    CHECK_REL(P.levels[0].n0, n0, 1e-12);
+    CHECK_REL(P.levels[0].lambda0, l0sq * 0.01, 1e-12);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+/* A 2-D tank: box [0, 1] x [0, 0.6], fluid inside, l0 = 0.1, 2 dummy layers.  Lattice
+ * points within 0.2 outside or on the box: 15 x 11 = 165, less 9 x 5 = 45 inside; the wall
+ * layer is the box outline, 11 x 7 - 45 = 32.  Fluid box [0, 0.5] x [0, 0.3]: 6 x 4 lattice
+ * points, of which those on the walls (x = 0 or y = 0) go: 5 x 3 = 15. */
+static void test_tank_2d(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    generate("dimension: 2\nl0: 0.1\ndomain: { min: [-0.3, -0.3], max: [1.3, 0.9] }\n"
+             "walls:\n  tank: { type: box, min: [0, 0], max: [1, 0.6], fluid: inside }\n"
+             "fluid:\n  - { type: box, min: [0, 0], max: [0.5, 0.3] }\n",
+             &g, &P, NULL);
+    CHECK(count_of(&P, LUB_WALL, -1) == 32);
+    CHECK(count_of(&P, LUB_DUMMY, -1) == 88);
+    CHECK(count_of(&P, LUB_FLUID, -1) == 15);
+    /* no duplicates: all pairs at least l0 apart (the lattice) */
+    double dmin = INFINITY;
+    for (size_t i = 0; i < P.n; i++)
+        for (size_t j = i + 1; j < P.n; j++)
+            dmin = fmin(dmin, hypot(P.x[0][i] - P.x[0][j], P.x[1][i] - P.x[1][j]));
+    CHECK_NEAR(dmin, 0.1, 1e-12);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+/* The same tank made of three planes with the corner filled: floor and two side walls. */
+static void test_tank_planes(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    generate("dimension: 2\nl0: 0.1\ndomain: { min: [-0.2, -0.2], max: [1.2, 0.6] }\n"
+             "walls:\n"
+             "  floor: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+             "  left:  { type: plane, point: [0, 0], normal: [1, 0] }\n"
+             "  right: { type: plane, point: [1, 0], normal: [-1, 0] }\n"
+             "fluid:\n  - { type: box, min: [0, 0], max: [1, 0.3] }\n",
+             &g, &P, NULL);
+    /* lattice 15 x 9 = 135 points; fluid side x in 0.1..0.9, y in 0.1..0.6: 9 x 6 = 54;
+     * the wall layer is the U: floor x 0..1 (11) + sides y 0.1..0.6 (2 x 6) = 23 */
+    CHECK(count_of(&P, LUB_WALL, -1) == 23);
+    CHECK(count_of(&P, LUB_DUMMY, -1) == 135 - 54 - 23);
+    CHECK(count_of(&P, LUB_FLUID, -1) == 9 * 3);
+    double dmin = INFINITY;
+    for (size_t i = 0; i < P.n; i++)
+        for (size_t j = i + 1; j < P.n; j++)
+            dmin = fmin(dmin, hypot(P.x[0][i] - P.x[0][j], P.x[1][i] - P.x[1][j]));
+    CHECK_NEAR(dmin, 0.1, 1e-12);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+/* Cylinder arc: R = 1, l0 = 0.05, range |x| <= 0.5, domain below y = 0.5 (bottom arc only).
+ * Angles from the lowest point in steps l0/r: |x| = r sin(phi) <= 0.5 keeps i <= 10 on each
+ * side for r = 1, 0.95 and 0.9: 21 points per layer. */
+static void test_cylinder_arc(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    generate("dimension: 2\nl0: 0.05\ndomain: { min: [-2, -2], max: [2, 0.5] }\n"
+             "walls:\n  c: { type: cylinder, centre: [0, 0], radius: 1, range: [-0.5, 0.5] }\n",
+             &g, &P, NULL);
+    CHECK(count_of(&P, LUB_WALL, -1) == 21);
+    CHECK(count_of(&P, LUB_DUMMY, -1) == 42);
+    double ang[64];
+    int n = 0, bad = 0;
+    for (size_t i = 0; i < P.n; i++) {
+        double r = hypot(P.x[0][i], P.x[1][i]);
+        if (P.kind[i] == LUB_WALL) {
+            if (fabs(r - 1.0) > 1e-12) bad++;
+            ang[n++] = atan2(P.x[0][i], -P.x[1][i]);
+        } else if (fabs(r - 0.95) > 1e-12 && fabs(r - 0.9) > 1e-12) {
+            bad++;
+        }
+    }
+    CHECK(bad == 0);
+    /* sorted angles: neighbours exactly l0 apart along the arc */
+    for (int i = 0; i < n; i++)
+        for (int j = i + 1; j < n; j++)
+            if (ang[j] < ang[i]) {
+                double t = ang[i];
+                ang[i] = ang[j], ang[j] = t;
+            }
+    for (int i = 0; i + 1 < n; i++) CHECK_NEAR((ang[i + 1] - ang[i]) * 1.0, 0.05, 1e-12);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+    /* a full circle inside the domain closes with n = round(2 pi R / l0) equal steps */
+    generate("dimension: 2\nl0: 0.05\ndomain: { min: [-2, -2], max: [2, 2] }\n"
+             "walls:\n  c: { type: cylinder, centre: [0, 0], radius: 1 }\n",
+             &g, &P, NULL);
+    CHECK(count_of(&P, LUB_WALL, -1) == 126);
+    double step = 2 * M_PI / 126;
+    for (size_t i = 0; i + 1 < P.n && P.kind[i + 1] == LUB_WALL; i++) {
+        double d = hypot(P.x[0][i + 1] - P.x[0][i], P.x[1][i + 1] - P.x[1][i]);
+        CHECK_NEAR(d, 2 * sin(step / 2), 1e-12);
+        CHECK(fabs(d - 0.05) < 0.005 * 0.05);
+    }
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+/* Small wedge: fluid keeps >= 0.999 wallGap l0 from every wall and dummy particle (minimum
+ * image across the periodic seam), never lies inside the cylinder, and the gap under the
+ * cylinder holds the rows that keep that distance. */
+static void test_wedge_gap(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    size_t rc[1];
+    generate("dimension: 2\nl0: 0.01\ndomain: { min: [-0.5, -0.03], max: [0.5, 0.3] }\n"
+             "periodic: [x]\nwallGap: 1.5\n"
+             "walls:\n  floor: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+             "  cyl: { type: cylinder, lowestPoint: [0, 0.05], radius: 1 }\n"
+             "fluid:\n  - { type: layer, wall: floor, thickness: 0.1 }\n",
+             &g, &P, rc);
+    double dmin = INFINITY;
+    int inside = 0;
+    for (size_t i = 0; i < P.n; i++) {
+        if (P.kind[i] != LUB_FLUID) continue;
+        if (hypot(P.x[0][i], P.x[1][i] - 1.05) < 1.0) inside++;
+        for (size_t j = 0; j < P.n; j++) {
+            if (P.kind[j] == LUB_FLUID) continue;
+            double dx = P.x[0][i] - P.x[0][j];
+            dx -= round(dx);
+            dmin = fmin(dmin, hypot(dx, P.x[1][i] - P.x[1][j]));
+        }
+    }
+    CHECK(dmin >= 0.999 * 1.5 * 0.01);
+    CHECK(inside == 0);
+    /* the lattice is cell-centred in x (no column at x = 0); in the column x = 0.005 the
+     * cylinder surface is at 1.05 - sqrt(1 - 0.005^2) = 0.0500125 and its nearest particles
+     * at (0, 0.05), (0.01, 0.05005): rows y = 0.02 and 0.03 keep 1.5 l0 from both walls,
+     * y = 0.01 and 0.04 do not */
+    size_t col = 0;
+    for (size_t i = 0; i < P.n; i++)
+        if (P.kind[i] == LUB_FLUID && fabs(P.x[0][i] - 0.005) < 1e-9) col++;
+    CHECK(col == 2);
+    CHECK(rc[0] == count_of(&P, LUB_FLUID, -1));
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+/* Two levels, periodic in x [0, 2): fine l0 = 0.05 owns [0.5, 1.0] (10 columns), coarse
+ * 0.1 the rest (15 columns); fluid layer 0.2 thick: 4 fine rows, 2 coarse rows. */
+static void test_levels(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    generate("dimension: 2\n"
+             "levels:\n  - { l0: 0.05, region: [0.5, 1.0] }\n  - { l0: 0.1 }\n"
+             "domain: { min: [0, -0.3], max: [2, 1] }\nperiodic: [x]\n"
+             "walls:\n  floor: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+             "fluid:\n  - { type: layer, wall: floor, thickness: 0.2 }\n",
+             &g, &P, NULL);
+    CHECK(P.nlevels == 2);
+    CHECK(count_of(&P, LUB_WALL, 0) == 10 && count_of(&P, LUB_DUMMY, 0) == 20);
+    CHECK(count_of(&P, LUB_FLUID, 0) == 40);
+    CHECK(count_of(&P, LUB_WALL, 1) == 15 && count_of(&P, LUB_DUMMY, 1) == 30);
+    CHECK(count_of(&P, LUB_FLUID, 1) == 30);
+    int bad = 0;
+    for (size_t i = 0; i < P.n; i++) {
+        int fine = P.x[0][i] >= 0.5 && P.x[0][i] <= 1.0;
+        if (fine != (P.level[i] == 0)) bad++;
+    }
+    CHECK(bad == 0);
+    double l0sq, n0 = n0_2d_by_shells(&l0sq);
+    CHECK_REL(P.levels[0].l0, 0.05, 0);
+    CHECK_REL(P.levels[1].re, 0.31, 1e-14);
+    CHECK_REL(P.levels[1].n0, n0, 1e-12); /* n0 does not depend on l0 */
+    CHECK_REL(P.levels[1].lambda0, l0sq * 0.01, 1e-12);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+/* 3-D tank: box [0, 0.4]^3, l0 = 0.1, 2 dummy layers: 9^3 = 729 lattice points within the
+ * dummy shell or on the box, 27 strictly inside; wall layer 5^3 - 3^3 = 98.  Fluid box
+ * [0, 0.4] x [0, 0.2] x [0, 0.4]: points not on the walls: 3 x 2 x 3 = 18. */
+static void test_tank_3d(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    generate("dimension: 3\nl0: 0.1\ndomain: { min: [-0.3, -0.3, -0.3], max: [0.7, 0.7, 0.7] }\n"
+             "walls:\n  tank: { type: box, min: [0, 0, 0], max: [0.4, 0.4, 0.4] }\n"
+             "fluid:\n  - { type: box, min: [0, 0, 0], max: [0.4, 0.2, 0.4] }\n",
+             &g, &P, NULL);
+    CHECK(count_of(&P, LUB_WALL, -1) == 98);
+    CHECK(count_of(&P, LUB_DUMMY, -1) == 729 - 27 - 98);
+    CHECK(count_of(&P, LUB_FLUID, -1) == 18);
+    double l0sq;
+    (void)n0_2d_by_shells(&l0sq);
+    CHECK(P.levels[0].n0 > 4.178307937 * 2); /* 3-D lattice: more neighbours */
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+/* 3-D plane (periodic x and z), sphere and cylinder walls: surfaces at R. */
+static void test_walls_3d(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    generate("dimension: 3\nl0: 0.05\n"
+             "domain: { min: [-1, -0.2, -1], max: [1, 1.5, 1] }\nperiodic: [x, z]\n"
+             "walls:\n  floor: { type: plane, point: [0, 0, 0], normal: [0, 1, 0] }\n"
+             "  ball: { type: sphere, centre: [0.5, 0.8, 0], radius: 0.3 }\n"
+             "  shaft: { type: cylinder, centre: [-0.5, 0.8, 0], axis: [0, 0, 1], "
+             "radius: 0.2 }\n"
+             "fluid:\n  - { type: layer, wall: floor, thickness: 0.1 }\n",
+             &g, &P, NULL);
+    int bad = 0;
+    size_t nb = 0, ns = 0, nf = 0;
+    for (size_t i = 0; i < P.n; i++) {
+        double *c = (double[]){P.x[0][i], P.x[1][i], P.x[2][i]};
+        if (P.kind[i] != LUB_WALL) continue;
+        if (P.patch[i] == 1) {
+            nb++;
+            if (fabs(sqrt(pow(c[0] - 0.5, 2) + pow(c[1] - 0.8, 2) + c[2] * c[2]) - 0.3) > 1e-12)
+                bad++;
+        } else if (P.patch[i] == 2) {
+            ns++;
+            if (fabs(hypot(c[0] + 0.5, c[1] - 0.8) - 0.2) > 1e-12) bad++;
+        } else {
+            nf++;
+        }
+    }
+    CHECK(bad == 0);
+    CHECK(nf == 40 * 40); /* periodic 2 / 0.05 in x and z */
+    /* sphere: about 4 pi R^2 / l0^2 = 452 points; cylinder 40 rings of round(2 pi 0.2/0.05) */
+    CHECK(nb > 400 && nb < 500);
+    CHECK(ns == 40 * 25);
+    CHECK(count_of(&P, LUB_FLUID, -1) == 40 * 40 * 2);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+/* Bad input found while discretising: empty region, off-lattice wall, too many particles. */
+static void test_bad_discretise(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    read_text(&g, "dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\n"
+                  "walls:\n  floor: { type: plane, point: [0, 2], normal: [0, 1] }\n"
+                  "fluid:\n  - { type: layer, wall: floor, thickness: 0.5 }\n");
+    CHECK_FATAL(lub_geometry_discretise(&g, &P, 0.0, NULL), "has no particles");
+    CHECK_STR(test_last_error, ":7:");
+    lub_geometry_free(&g);
+    read_text(&g, "dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\n"
+                  "walls:\n  floor: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+                  "  cyl: { type: cylinder, centre: [0.5, 0.5], radius: 2, fluid: outside }\n"
+                  "fluid:\n  - { type: layer, wall: floor, thickness: 0.5 }\n");
+    CHECK_FATAL(lub_geometry_discretise(&g, &P, 0.0, NULL), "has no particles");
+    lub_geometry_free(&g);
+    read_text(&g, "dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\n"
+                  "walls:\n  floor: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+                  "  lid: { type: plane, point: [0, 0.55], normal: [0, -1] }\n");
+    CHECK_FATAL(lub_geometry_discretise(&g, &P, 0.0, NULL), "not on the particle lattice");
+    CHECK_STR(test_last_error, ":6:");
+    lub_geometry_free(&g);
+    read_text(&g, "dimension: 3\nl0: 1e-7\ndomain: { min: [0, 0, 0], max: [1, 1, 1] }\n");
+    CHECK_FATAL(lub_geometry_discretise(&g, &P, 0.0, NULL), "l0 = 1e-07 over the domain");
+    CHECK_STR(test_last_error, ":2:");
+    lub_geometry_free(&g);
+    /* the limit follows the memory given: 10 x 10 lattice, 1 kB is too little */
+    read_text(&g, "dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\n");
+    CHECK_FATAL(lub_geometry_discretise(&g, &P, 1000.0, NULL), "more than the");
+    lub_geometry_free(&g);
+}
+
+/* Segment and polyline walls: wall points on the curve, n = round(length / l0) equal steps
+ * (segment (0,0)-(1,0.5): length 1.118, 11 steps, 12 points), dummies 1 and 2 l0 behind. */
+static void test_curves(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    generate("dimension: 2\nl0: 0.1\ndomain: { min: [-1, -1], max: [3, 2] }\n"
+             "walls:\n  s: { type: segment, from: [0, 0], to: [1, 0.5] }\n"
+             "  p: { type: polyline, points: [[1.5, 0], [2, 0.5], [2.5, 0]], fluid: below }\n",
+             &g, &P, NULL);
+    size_t nw[2] = {0, 0}, nd[2] = {0, 0};
+    int bad = 0;
+    double step = hypot(1, 0.5) / 11;
+    for (size_t i = 0; i < P.n; i++) {
+        int w = P.patch[i];
+        double d = lub_wall_distance(&g.walls[w], (double[]){P.x[0][i], P.x[1][i]}, 2);
+        if (P.kind[i] == LUB_WALL) {
+            nw[w]++;
+            if (fabs(d) > 1e-12) bad++;
+            if (w == 0) { /* on the lattice of the segment: s = k step from `from` */
+                double s = hypot(P.x[0][i], P.x[1][i]) / step;
+                if (fabs(s - round(s)) > 1e-9) bad++;
+            }
+        } else {
+            nd[w]++;
+            if (w == 0 && !(fabs(d + 0.1) < 1e-12 || fabs(d + 0.2) < 1e-12)) bad++;
+            if (w == 1 && !(d < -0.05 && d > -0.2 - 1e-12)) bad++;
+        }
+    }
+    CHECK(bad == 0);
+    CHECK(nw[0] == 12 && nd[0] == 24);
+    /* polyline: length 2 sqrt(0.5) = 1.414, 14 steps, 15 points */
+    CHECK(nw[1] == 15);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+/* Fluid between a floor and a cylinder (R = 1, lowest point 0.1 above the floor) up to
+ * 0.3, l0 = 0.02, periodic x in [-1, 1).  Column x = 0.01: cylinder surface at
+ * 1.1 - sqrt(1 - 0.01^2) = 0.10005, the nearest cylinder particles at (0, 0.1) and
+ * (0.02, 0.1002): rows 0.02 .. 0.08 keep one l0 from both walls (4 rows).  Column
+ * x = 0.99: the cylinder is at 0.96, so the rows 0.02 .. 0.30 are filled (15 rows). */
+static void test_between(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    size_t rc[1];
+    generate("dimension: 2\nl0: 0.02\ndomain: { min: [-1, -0.06], max: [1, 1.2] }\n"
+             "periodic: [x]\n"
+             "walls:\n  floor: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+             "  cyl: { type: cylinder, lowestPoint: [0, 0.1], radius: 1 }\n"
+             "fluid:\n  - { type: between, lower: floor, upper: cyl, height: 0.3 }\n",
+             &g, &P, rc);
+    size_t c1 = 0, c2 = 0;
+    int bad = 0;
+    for (size_t i = 0; i < P.n; i++) {
+        if (P.kind[i] != LUB_FLUID) continue;
+        double x = P.x[0][i], y = P.x[1][i];
+        if (fabs(x - 0.01) < 1e-9) c1++;
+        if (fabs(x - 0.99) < 1e-9) c2++;
+        if (y > 0.3 + 1e-9 || y < 0.02 - 1e-9) bad++;
+        if (hypot(x, y - 1.1) < 1.0) bad++;
+    }
+    CHECK(bad == 0);
+    CHECK(c1 == 4);
+    CHECK(c2 == 15);
+    CHECK(rc[0] == count_of(&P, LUB_FLUID, -1));
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+/* Walls at the level that owns them: a cylinder arc (R = 1, lowest point (0, 0.05)) with
+ * fine l0 = 0.01 in [-0.2, 0.2] and coarse 0.04 elsewhere; arc neighbours are l0 of their
+ * level apart (angles from the lowest point in steps l0 / R), all at radius R. */
+static void test_levels_arc(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    generate("dimension: 2\n"
+             "levels:\n  - { l0: 0.01, region: [-0.2, 0.2] }\n  - { l0: 0.04 }\n"
+             "domain: { min: [-0.8, -0.2], max: [0.8, 0.5] }\nperiodic: [x]\n"
+             "walls:\n  cyl: { type: cylinder, lowestPoint: [0, 0.05], radius: 1 }\n",
+             &g, &P, NULL);
+    double ang[2][256];
+    int n[2] = {0, 0}, bad = 0;
+    for (size_t i = 0; i < P.n; i++) {
+        if (P.kind[i] != LUB_WALL) continue;
+        double x = P.x[0][i], y = P.x[1][i] - 1.05;
+        int k = P.level[i];
+        if (fabs(hypot(x, y) - 1.0) > 1e-12) bad++;
+        if ((fabs(x) <= 0.2) != (k == 0)) bad++;
+        if (n[k] < 256) ang[k][n[k]++] = atan2(x, -y);
+    }
+    CHECK(bad == 0);
+    /* fine: |x| = sin(phi) <= 0.2 -> phi <= 0.20136, i <= 20 each side: 41 points;
+     * coarse: sin(phi) > 0.2 -> i >= 6; domain top y = 0.5 -> cos(phi) >= 0.55 ->
+     * phi <= 0.9884; domain side |x| <= 0.8 -> phi <= 0.9273: i = 6 .. 23, 36 points */
+    CHECK(n[0] == 41);
+    CHECK(n[1] == 36);
+    for (int k = 0; k < 2; k++) {
+        for (int i = 0; i < n[k]; i++)
+            for (int j = i + 1; j < n[k]; j++)
+                if (ang[k][j] < ang[k][i]) {
+                    double t = ang[k][i];
+                    ang[k][i] = ang[k][j], ang[k][j] = t;
+                }
+        double l0 = k ? 0.04 : 0.01;
+        for (int i = 0; i + 1 < n[k]; i++) {
+            double d = ang[k][i + 1] - ang[k][i];
+            if (k == 1 && d > 0.1) continue; /* the fine part between the coarse sides */
+            CHECK_NEAR(d, l0, 1e-12);
+        }
+    }
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+int main(void)
+{
+    RUN(test_read_wedge);
+    RUN(test_wall_functions);
+    RUN(test_wall_functions_3d);
+    RUN(test_read_levels);
+    RUN(test_bad_input);
+    RUN(test_plane_layer);
+    RUN(test_tank_2d);
+    RUN(test_tank_planes);
+    RUN(test_cylinder_arc);
+    RUN(test_wedge_gap);
+    RUN(test_levels);
+    RUN(test_levels_arc);
+    RUN(test_tank_3d);
+    RUN(test_walls_3d);
+    RUN(test_curves);
+    RUN(test_between);
+    RUN(test_bad_discretise);
+    unlink(tmp_path);
+    return test_summary();
+}
