@@ -1,0 +1,175 @@
+/* lubFoam function objects: tables written during the run under
+ * postProcessing/<name>/<startTime>/ (controlDict `functions`, as in OpenFOAM).
+ *
+ *     functions:
+ *       totals:       { type: totals, interval: 100 }         # every 100 steps
+ *       wallPressure: { type: wallPressure, patch: cylinder, bin: 2.5e-5,
+ *                       from: -0.0045, to: 0.0045,             # x range (default: domain)
+ *                       timeStart: 0.024, timeEnd: 0.030 }     # averaging window
+ *
+ * totals.dat:  # t mass momentumX momentumY momentumZ kineticEnergy fluidParticles
+ *              (per unit depth in 2-D: particle mass rho l0^d)
+ * p.dat:       # x p n   wall pressure of the patch averaged over the window and the bin
+ *              (n: samples); rewritten at every write time and at the end.
+ * The cost table (postProcessing/cost/<startTime>/cost.dat) is written by lubFoam itself.
+ */
+#include <errno.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "io/table.h"
+#include "lubFoam.h"
+
+enum { FO_TOTALS, FO_WALLPRESSURE };
+
+typedef struct {
+    int type;
+    char name[64];
+    long interval;
+    FILE *fp; /* totals: appended during the run */
+    /* wallPressure */
+    int patch;
+    double from, to, bin, t0, t1;
+    int nbins;
+    double *sum;
+    long *count;
+} fo;
+
+struct lubfoam_functions {
+    int n;
+    fo *f;
+};
+
+lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
+{
+    static const char *const types[] = {"totals", "wallPressure", NULL};
+    lubfoam_functions *F = lub_calloc(1, sizeof *F);
+    lub_node *fs = r->ctl.functions;
+    size_t n = fs ? lub_node_size(fs) : 0;
+    F->f = lub_calloc(n ? n : 1, sizeof *F->f);
+    for (size_t k = 0; k < n; k++) {
+        const char *name = lub_node_key_at(fs, k);
+        lub_node *d = lub_node_expect_map(lub_node_value_at(fs, k));
+        fo *o = &F->f[F->n++];
+        snprintf(o->name, sizeof o->name, "%s", name);
+        o->type = lub_dict_choice(d, "type", types, -1);
+        o->interval = lub_dict_int_or(d, "interval", 1, 1, 1L << 40);
+        char path[LUB_PATH_MAX];
+        if (o->type == FO_TOTALS) {
+            lub_postproc_path(&r->cs, name, r->start_name, "totals.dat", path);
+            o->fp = fopen(path, "w");
+            if (!o->fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+            lub_table_write_header(o->fp, "t mass momentumX momentumY momentumZ kineticEnergy "
+                                          "fluidParticles");
+        } else {
+            const char *patch = lub_dict_str(d, "patch");
+            o->patch = lub_particles_find_patch(&r->P, patch);
+            if (o->patch < 0) {
+                char list[512] = "";
+                size_t len = 0;
+                for (int p = 0; p < r->P.npatches && len < sizeof list; p++)
+                    len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", p ? ", " : "",
+                                            r->P.patch_names[p]);
+                lub_node_error(lub_dict_get(d, "patch"),
+                               "function '%s': no patch '%s' in the particles (patches: %s)",
+                               name, patch, list);
+            }
+            o->from = lub_dict_real_or(d, "from", r->mps.lo[0], LUB_ANY);
+            o->to = lub_dict_real_or(d, "to", r->mps.hi[0], LUB_ANY);
+            if (!(o->to > o->from))
+                lub_node_error(d, "function '%s': 'to' (%g) must be greater than 'from' (%g)",
+                               name, o->to, o->from);
+            o->bin = lub_dict_real_or(d, "bin", 4 * r->mps.l0, LUB_POSITIVE);
+            o->t0 = lub_dict_real_or(d, "timeStart", 0.0, LUB_NONNEGATIVE);
+            o->t1 = lub_dict_real_or(d, "timeEnd", INFINITY, LUB_NONNEGATIVE);
+            o->nbins = (int)ceil((o->to - o->from) / o->bin - 1e-9);
+            if (o->nbins < 1 || o->nbins > 10000000)
+                lub_node_error(d, "function '%s': %d bins", name, o->nbins);
+            o->sum = lub_calloc((size_t)o->nbins, sizeof *o->sum);
+            o->count = lub_calloc((size_t)o->nbins, sizeof *o->count);
+        }
+    }
+    return F;
+}
+
+static void totals(fo *o, lubfoam_run *r)
+{
+    const lub_particles *P = &r->P;
+    double mp = r->mps.c.rho * pow(r->mps.l0, P->dim);
+    double mom[3] = {0, 0, 0}, ke = 0;
+    size_t nf = 0;
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->kind[i] != LUB_FLUID) continue;
+        nf++;
+        for (int d = 0; d < P->dim; d++) {
+            mom[d] += mp * P->u[d][i];
+            ke += 0.5 * mp * P->u[d][i] * P->u[d][i];
+        }
+    }
+    double row[7] = {r->t, mp * (double)nf, mom[0], mom[1], mom[2], ke, (double)nf};
+    lub_table_write_row(o->fp, row, 7);
+    fflush(o->fp);
+}
+
+static void wall_pressure(fo *o, lubfoam_run *r)
+{
+    if (r->t < o->t0 - 0.5 * r->dt || r->t > o->t1 + 0.5 * r->dt) return;
+    const lub_particles *P = &r->P;
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->kind[i] != LUB_WALL || P->patch[i] != o->patch) continue;
+        double x = P->x[0][i];
+        if (x < o->from || x >= o->to) continue;
+        int b = (int)((x - o->from) / o->bin);
+        if (b >= o->nbins) b = o->nbins - 1;
+        o->sum[b] += P->p[i];
+        o->count[b]++;
+    }
+}
+
+void lubfoam_functions_execute(lubfoam_functions *F, lubfoam_run *r)
+{
+    for (int k = 0; k < F->n; k++) {
+        fo *o = &F->f[k];
+        if (r->step % o->interval != 0) continue;
+        if (o->type == FO_TOTALS)
+            totals(o, r);
+        else
+            wall_pressure(o, r);
+    }
+}
+
+void lubfoam_functions_write(lubfoam_functions *F, lubfoam_run *r)
+{
+    for (int k = 0; k < F->n; k++) {
+        fo *o = &F->f[k];
+        if (o->type != FO_WALLPRESSURE) continue;
+        char path[LUB_PATH_MAX];
+        lub_postproc_path(&r->cs, o->name, r->start_name, "p.dat", path);
+        lub_atomic_file af;
+        FILE *fp = lub_atomic_open(&af, path);
+        if (!fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+        lub_table_write_header(fp, "x p n");
+        for (int b = 0; b < o->nbins; b++) {
+            if (!o->count[b]) continue;
+            double row[3] = {o->from + (b + 0.5) * o->bin, o->sum[b] / (double)o->count[b],
+                             (double)o->count[b]};
+            lub_table_write_row(fp, row, 3);
+        }
+        if (lub_atomic_close(&af) != 0)
+            lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+    }
+}
+
+void lubfoam_functions_free(lubfoam_functions *F)
+{
+    if (!F) return;
+    for (int k = 0; k < F->n; k++) {
+        if (F->f[k].fp) fclose(F->f[k].fp);
+        free(F->f[k].sum);
+        free(F->f[k].count);
+    }
+    free(F->f);
+    free(F);
+}

@@ -1,0 +1,274 @@
+/* lubFoam: the semi-implicit MPS solver (methods.md §1-2).
+ *
+ * Reads the case's dictionaries and the particles of the start time, checks the stability
+ * limits, then advances in time, writing time folders and function-object tables, and
+ * reports what the run cost.
+ */
+#include <errno.h>
+#include <math.h>
+#include <omp.h>
+#include <signal.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "core/args.h"
+#include "core/error.h"
+#include "geometry/geometry.h"
+#include "io/particles_io.h"
+#include "io/table.h"
+#include "lubFoam.h"
+
+static volatile sig_atomic_t stop_signal = 0;
+static void on_signal(int sig) { stop_signal = sig; }
+
+static void format_hms(double s, char *buf, size_t size)
+{
+    if (!isfinite(s) || s < 0) {
+        snprintf(buf, size, "--:--:--");
+        return;
+    }
+    long t = (long)(s + 0.5);
+    snprintf(buf, size, "%ld:%02ld:%02ld", t / 3600, (t / 60) % 60, t % 60);
+}
+
+static double fraction_done(const lubfoam_run *r, long steps_done)
+{
+    if (r->ctl.stop_at == LUB_STOP_NSTEPS) return (double)steps_done / (double)r->ctl.n_steps;
+    double span = r->ctl.end_time - r->start_time;
+    return span > 0 ? (r->t - r->start_time) / span : 1.0;
+}
+
+/* Courant (T-18) and diffusion (T-30) numbers against their limits, before the first step. */
+static void check_limits(lubfoam_run *r)
+{
+    const lub_mps *m = &r->mps;
+    double umax = lub_mps_max_speed(m);
+    for (int k = 0; k < r->P.npatches; k++) {
+        const double *v = m->c.patch_velocity[k];
+        double s = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        if (s > umax) umax = s;
+    }
+    double co = umax * r->dt / m->l0;
+    if (r->ctl.adjust_time_step && umax > 0) {
+        double dtc = r->ctl.max_courant * m->l0 / umax;
+        if (dtc < r->dt) r->dt = dtc;
+        co = umax * r->dt / m->l0;
+    }
+    double dn = m->c.nu * r->dt / (m->l0 * m->l0);
+    lub_message("Stability: Courant %.4g (u_max %g m/s, dt %g s, l0 %g m; limit %g), "
+                "diffusion number %.4g (nu dt / l0^2; %s viscosity%s)",
+                co, umax, r->dt, m->l0, r->ctl.max_courant, dn,
+                m->c.viscosity == LUB_VISCOSITY_NONE       ? "no"
+                : m->c.viscosity == LUB_VISCOSITY_EXPLICIT ? "explicit"
+                                                           : "implicit",
+                m->c.viscosity == LUB_VISCOSITY_EXPLICIT ? ", limit maxDiffusion" : "");
+    if (co > r->ctl.max_courant * (1 + 1e-9))
+        lub_fatal("Courant number %.4g (u_max %g m/s x deltaT %g s / l0 %g m) exceeds maxCourant "
+                  "%g in system/controlDict.yaml: reduce deltaT to at most %.4g s or set "
+                  "adjustTimeStep: true",
+                  co, umax, r->dt, m->l0, r->ctl.max_courant, r->ctl.max_courant * m->l0 / umax);
+    if (m->c.viscosity == LUB_VISCOSITY_EXPLICIT && dn > r->ctl.max_diffusion)
+        lub_fatal("diffusion number %.4g (nu %g m^2/s x deltaT %g s / l0^2) exceeds maxDiffusion "
+                  "%g with explicit viscosity: use 'viscosity: { scheme: crankNicolson }' in "
+                  "constant/models.yaml or reduce deltaT to at most %.4g s",
+                  dn, m->c.nu, r->dt, r->ctl.max_diffusion,
+                  r->ctl.max_diffusion * m->l0 * m->l0 / m->c.nu);
+}
+
+static void print_header(const lubfoam_run *r)
+{
+    const lub_mps *m = &r->mps;
+    size_t cnt[3] = {0, 0, 0};
+    for (size_t i = 0; i < r->P.n; i++) cnt[r->P.kind[i] < 3 ? r->P.kind[i] : 0]++;
+    char ps[256], vs[256];
+    lub_linsolver_describe(&m->psolver, ps, sizeof ps);
+    lub_linsolver_describe(&m->vsolver, vs, sizeof vs);
+    lub_message("lubFoam: case %s, start time %s (step %ld), %d-D", r->cs.root, r->start_name,
+                r->step, m->dim);
+    lub_message("Particles: %zu (fluid %zu, wall %zu, dummy %zu), threads %d", r->P.n, cnt[0],
+                cnt[1], cnt[2], omp_get_max_threads());
+    lub_message("MPS: l0 %g m, re %g m (%g l0), n0 %.10g, lambda0 %.10g m^2", m->l0, m->re,
+                m->c.re_l0, m->n0, m->lambda0);
+    lub_message("Schemes: gradient %s%s, gamma %g, alpha %g, surface beta %g, viscosity %s",
+                m->c.gradient == LUB_GRADIENT_LSMPS ? "lsmps" : "standard",
+                m->c.min_pressure_shift ? " (min-pressure shift)" : "", m->c.gamma, m->c.alpha,
+                m->c.beta,
+                m->c.viscosity == LUB_VISCOSITY_NONE       ? "none"
+                : m->c.viscosity == LUB_VISCOSITY_EXPLICIT ? "explicit"
+                                                           : "crankNicolson");
+    lub_message("Solvers: p %s; U %s", ps, vs);
+}
+
+static void log_line(const lubfoam_run *r, long steps_done, double wall0, double pit_sum)
+{
+    const lub_mps *m = &r->mps;
+    double frac = fraction_done(r, steps_done);
+    double el = lub_wtime() - wall0;
+    char eta[32];
+    format_hms(frac > 0 ? el * (1 - frac) / frac : NAN, eta, sizeof eta);
+    lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g p %3d it %8.2e (mean %.1f)  "
+                "surf %-6zu ETA %s",
+                r->t, 100 * frac, r->step, r->dt, m->st.umax * r->dt / m->l0, m->st.p.iterations,
+                m->st.p.residual, steps_done ? pit_sum / (double)steps_done : 0.0,
+                m->st.nsurface, eta);
+}
+
+static void progress_bar(const lubfoam_run *r, long steps_done, double wall0)
+{
+    double frac = fraction_done(r, steps_done);
+    double el = lub_wtime() - wall0;
+    char eta[32];
+    format_hms(frac > 0 ? el * (1 - frac) / frac : NAN, eta, sizeof eta);
+    int w = 30, k = (int)(frac * w);
+    char bar[64];
+    for (int i = 0; i < w; i++) bar[i] = i < k ? '#' : '.';
+    bar[w] = '\0';
+    fprintf(stdout, "\r[%s] %5.1f%% t %-10.5g ETA %s ", bar, 100 * frac, r->t, eta);
+    fflush(stdout);
+}
+
+/* Cost summary on the log and in postProcessing/cost/<startTime>/cost.dat. */
+static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum)
+{
+    const lub_mps *m = &r->mps;
+    double ps = (double)r->P.n * (double)steps;
+    double us = ps > 0 ? 1e6 * wall / ps : 0;
+    lub_message("Cost: %ld steps, %zu particles, %.6g particle-steps in %.3f s wall: "
+                "%.4g us per particle-step (%d threads)",
+                steps, r->P.n, ps, wall, us, omp_get_max_threads());
+    for (int k = 0; k < LUB_T_COUNT; k++)
+        lub_message("  %-16s %10.3f s  %5.1f%%", lub_mps_phase_names[k], m->tm.seconds[k],
+                    wall > 0 ? 100 * m->tm.seconds[k] / wall : 0.0);
+    char path[LUB_PATH_MAX];
+    lub_postproc_path(&r->cs, "cost", r->start_name, "cost.dat", path);
+    lub_atomic_file af;
+    FILE *fp = lub_atomic_open(&af, path);
+    if (!fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+    char names[512];
+    size_t len = (size_t)snprintf(names, sizeof names,
+                                  "wallTime steps particles particleSteps usPerParticleStep "
+                                  "threads meanPressureIterations");
+    for (int k = 0; k < LUB_T_COUNT; k++)
+        len += (size_t)snprintf(names + len, sizeof names - len, " %s", lub_mps_phase_names[k]);
+    lub_table_write_header(fp, names);
+    double row[7 + LUB_T_COUNT] = {wall, (double)steps, (double)r->P.n, ps, us,
+                                   (double)omp_get_max_threads(),
+                                   steps ? pit_sum / (double)steps : 0.0};
+    for (int k = 0; k < LUB_T_COUNT; k++) row[7 + k] = m->tm.seconds[k];
+    lub_table_write_row(fp, row, 7 + LUB_T_COUNT);
+    if (lub_atomic_close(&af) != 0) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+}
+
+int main(int argc, char **argv)
+{
+    lub_program_info info = {
+        .name = "lubFoam",
+        .summary = "semi-implicit MPS solver for thin-film lubrication",
+        .usage = "[OPTIONS]",
+        .description = "  Starts from the time folder chosen by startFrom in system/controlDict.yaml,\n"
+                       "  advances to endTime (or nSteps), writes time folders and the tables of\n"
+                       "  the function objects, and reports its cost in\n"
+                       "  postProcessing/cost/<startTime>/cost.dat.  SIGINT/SIGTERM write the\n"
+                       "  current state and exit 0.",
+        .dictionaries = "system/controlDict.yaml\nsystem/particleGenDict.yaml (domain)\n"
+                        "system/schemes.yaml\nsystem/solution.yaml (optional)\n"
+                        "constant/transportProperties.yaml\nconstant/models.yaml",
+        .has_case = 1,
+        .min_args = 0,
+        .max_args = 0,
+    };
+    lub_args a;
+    lub_args_parse(&a, argc, argv, &info, NULL);
+
+    lubfoam_run r;
+    memset(&r, 0, sizeof r);
+    char path[LUB_PATH_MAX];
+    lub_case_open(&r.cs, a.case_dir);
+    lub_control_read(&r.ctl, lub_case_path(&r.cs, path, "system/controlDict.yaml"));
+    lub_geometry geo;
+    lub_geometry_read(&geo, lub_case_path(&r.cs, path, "system/particleGenDict.yaml"));
+    lubfoam_read_start(&r);
+    if (r.P.dim != geo.dim)
+        lub_fatal("the particles are %d-D but system/particleGenDict.yaml says dimension %d",
+                  r.P.dim, geo.dim);
+    lub_mps_config cfg;
+    lub_mps_config_read(&cfg, r.cs.root, &r.P);
+    lub_mps_init(&r.mps, &r.P, &cfg, geo.dmin, geo.dmax, geo.periodic);
+    lub_geometry_free(&geo);
+    lubfoam_functions *fos = lubfoam_functions_read(&r);
+    lub_dict_finish(r.ctl.dict);
+
+    print_header(&r);
+    check_limits(&r);
+
+    signal(SIGINT, on_signal);
+    signal(SIGTERM, on_signal);
+    const int tty = isatty(STDOUT_FILENO);
+    const double wall0 = lub_wtime();
+    const long step0 = r.step;
+    long steps = 0;
+    double pit_sum = 0, last_bar = 0;
+    int warned_courant = 0, status = LUB_EXIT_OK;
+
+    while (!lub_control_finished(&r.ctl, r.t, steps, r.dt)) {
+        if (r.ctl.adjust_time_step && r.mps.st.umax > 0) {
+            double dtc = r.ctl.max_courant * r.mps.l0 / r.mps.st.umax;
+            r.dt = dtc < r.ctl.delta_t ? dtc : r.ctl.delta_t;
+        }
+        if (r.ctl.stop_at == LUB_STOP_ENDTIME && r.t + r.dt > r.ctl.end_time)
+            r.dt = r.ctl.end_time - r.t; /* land on endTime exactly */
+        long bad;
+        char msg[1024];
+        lub_step_status s = lub_mps_step(&r.mps, r.dt, &bad, msg, sizeof msg);
+        if (s != LUB_STEP_OK) {
+            if (tty) fputc('\n', stdout);
+            fflush(stdout);
+            fprintf(stderr, "lubFoam: error: step %ld (t = %.9g s): %s\n", r.step + 1,
+                    r.t + r.dt, msg);
+            fprintf(stderr, "lubFoam: the last good state is the newest time folder\n");
+            status = LUB_EXIT_RUN;
+            break;
+        }
+        r.t += r.dt;
+        r.step++;
+        steps++;
+        pit_sum += r.mps.st.p.iterations;
+        double co = r.mps.st.umax * r.dt / r.mps.l0;
+        if (!r.ctl.adjust_time_step && co > r.ctl.max_courant && !warned_courant) {
+            lub_warning("step %ld: Courant number %.3g exceeds maxCourant %g (u_max %g m/s)",
+                        r.step, co, r.ctl.max_courant, r.mps.st.umax);
+            warned_courant = 1;
+        }
+        lubfoam_functions_execute(fos, &r);
+        int finished = lub_control_finished(&r.ctl, r.t, steps, r.dt);
+        if (lub_control_write_due(&r.ctl, r.start_time, r.t, step0, r.step, r.dt) || finished ||
+            stop_signal) {
+            lub_timer_start(&r.mps.tm, LUB_T_OUTPUT);
+            lubfoam_write(&r);
+            lubfoam_functions_write(fos, &r);
+            lub_mps_rebuild_lists(&r.mps); /* exact restart from this folder */
+            lub_timer_stop(&r.mps.tm, LUB_T_OUTPUT);
+        }
+        if (steps % r.ctl.log_interval == 0 || finished) {
+            if (tty) fputc('\r', stdout);
+            log_line(&r, steps, wall0, pit_sum);
+        } else if (tty && lub_wtime() - last_bar > 0.2) {
+            progress_bar(&r, steps, wall0);
+            last_bar = lub_wtime();
+        }
+        if (stop_signal) {
+            lub_message("Signal %d: state written at t = %.9g, stopping", (int)stop_signal, r.t);
+            break;
+        }
+    }
+    if (tty) fputc('\n', stdout);
+    write_cost(&r, steps, lub_wtime() - wall0, pit_sum);
+    lubfoam_functions_free(fos);
+    lub_mps_free(&r.mps);
+    lub_particles_free(&r.P);
+    lub_control_free(&r.ctl);
+    free(r.written);
+    if (status == LUB_EXIT_OK) lub_message("End");
+    return status;
+}

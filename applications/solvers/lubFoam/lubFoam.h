@@ -1,0 +1,38 @@
+/* lubFoam internals shared by its source files (not part of liblub). */
+#ifndef LUBFOAM_H
+#define LUBFOAM_H
+
+#include <stdio.h>
+
+#include "io/case.h"
+#include "io/control.h"
+#include "mps/mps.h"
+
+/* Run state the writers need. */
+typedef struct {
+    lub_case cs;
+    lub_control ctl;
+    lub_mps mps;
+    lub_particles P;
+    double t, dt;
+    long step;
+    double start_time;
+    char start_name[64];
+    /* time folders written by this run, oldest first (for purgeWrite) */
+    char (*written)[64];
+    size_t nwritten, capwritten;
+} lubfoam_run;
+
+/* Start time folder per controlDict (startFrom), reading particles and uniform/state.yaml. */
+void lubfoam_read_start(lubfoam_run *r);
+/* Write the current state as a time folder (atomic), update particles.xdmf, purge. */
+void lubfoam_write(lubfoam_run *r);
+
+/* Function objects (controlDict `functions`). */
+typedef struct lubfoam_functions lubfoam_functions;
+lubfoam_functions *lubfoam_functions_read(lubfoam_run *r);
+void lubfoam_functions_execute(lubfoam_functions *f, lubfoam_run *r);
+void lubfoam_functions_write(lubfoam_functions *f, lubfoam_run *r);
+void lubfoam_functions_free(lubfoam_functions *f);
+
+#endif

@@ -1,0 +1,103 @@
+/* lubFoam: start time, restart state and time folders. */
+#include <errno.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "core/error.h"
+#include "io/dict.h"
+#include "io/particles_io.h"
+#include "lubFoam.h"
+
+static int has_particles(const lub_case *c, const char *name)
+{
+    char p[LUB_PATH_MAX];
+    struct stat st;
+    lub_case_pathf(c, p, "%s/particles.h5", name);
+    return stat(p, &st) == 0;
+}
+
+void lubfoam_read_start(lubfoam_run *r)
+{
+    const lub_control *c = &r->ctl;
+    char name[64], path[LUB_PATH_MAX];
+    if (c->start_from == LUB_START_LATESTTIME) {
+        lub_time *t;
+        size_t n = lub_case_times(&r->cs, &t);
+        int found = 0;
+        for (size_t k = n; k-- > 0;)
+            if (has_particles(&r->cs, t[k].name)) {
+                snprintf(name, sizeof name, "%s", t[k].name);
+                found = 1;
+                break;
+            }
+        free(t);
+        if (!found)
+            lub_fatal("case '%s' has no time folder with particles.h5: run particleGen first",
+                      r->cs.root);
+    } else {
+        lub_time_name(c->start_time, c->time_precision, name, sizeof name);
+        if (!has_particles(&r->cs, name))
+            lub_fatal("startTime %g: no file '%s/%s/particles.h5' (startFrom: startTime)",
+                      c->start_time, r->cs.root, name);
+    }
+    snprintf(r->start_name, sizeof r->start_name, "%s", name);
+    lub_particles_read(&r->P, lub_case_pathf(&r->cs, path, "%s/particles.h5", name));
+    r->t = r->P.time;
+    r->step = r->P.step;
+    r->dt = c->delta_t;
+
+    /* uniform/state.yaml: the exact time and time step of a run that wrote this folder */
+    lub_dict *st = lub_dict_read_optional(lub_case_pathf(&r->cs, path, "%s/uniform/state.yaml", name));
+    if (st) {
+        lub_node *root = lub_dict_root(st);
+        r->t = lub_dict_real(root, "time", LUB_NONNEGATIVE);
+        r->step = lub_dict_int(root, "step", 0, 1L << 62);
+        double dt = lub_dict_real_or(root, "deltaT", c->delta_t, LUB_POSITIVE);
+        if (c->adjust_time_step) r->dt = dt < c->delta_t ? dt : c->delta_t;
+        lub_dict_finish(st);
+        lub_dict_free(st);
+    }
+    r->start_time = r->t;
+}
+
+static void write_state(const lubfoam_run *r, const char *dir)
+{
+    char udir[LUB_PATH_MAX + 16], path[LUB_PATH_MAX + 32];
+    snprintf(udir, sizeof udir, "%s/uniform", dir);
+    if (lub_mkdir_p(udir) != 0) lub_fatal_run("cannot create '%s': %s", udir, strerror(errno));
+    snprintf(path, sizeof path, "%s/state.yaml", udir);
+    FILE *fp = fopen(path, "w");
+    if (!fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+    fprintf(fp, "# written by lubFoam: what an exact restart needs\n");
+    fprintf(fp, "time:   %.17g\n", r->t);
+    fprintf(fp, "step:   %ld\n", r->step);
+    fprintf(fp, "deltaT: %.17g\n", r->dt);
+    if (fclose(fp) != 0) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+}
+
+void lubfoam_write(lubfoam_run *r)
+{
+    char name[64], dir[LUB_PATH_MAX];
+    lub_time_name(r->t, r->ctl.time_precision, name, sizeof name);
+    r->P.time = r->t;
+    r->P.step = r->step;
+    lub_timedir_begin(&r->cs, name, dir);
+    lub_particles_write(&r->P, dir);
+    write_state(r, dir);
+    lub_timedir_commit(&r->cs, name, dir);
+    lub_case_xdmf_write(&r->cs);
+
+    if (r->nwritten == r->capwritten) {
+        r->capwritten = r->capwritten ? 2 * r->capwritten : 16;
+        r->written = lub_realloc(r->written, r->capwritten * sizeof *r->written);
+    }
+    snprintf(r->written[r->nwritten++], 64, "%s", name);
+    if (r->ctl.purge_write > 0 && r->nwritten > (size_t)r->ctl.purge_write) {
+        char old[LUB_PATH_MAX];
+        lub_rm_rf(lub_case_path(&r->cs, old, r->written[0]));
+        memmove(r->written, r->written + 1, (r->nwritten - 1) * sizeof *r->written);
+        r->nwritten--;
+        lub_case_xdmf_write(&r->cs);
+    }
+}

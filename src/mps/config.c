@@ -1,0 +1,175 @@
+/* lubkit MPS: the solver's dictionaries (see mps.h).
+ *
+ * system/schemes.yaml (defaults in etc/templates/schemes.yaml):
+ *
+ *     effectiveRadius:  3.1          # re / l0 (T-6)
+ *     gradient:         lsmps        # standard (T-13) | lsmps (T-15)
+ *     minPressureShift: true         # p_hat of T-14 in the gradient
+ *     negativePressure: clip         # clip | keep
+ *     dummyVelocity:    mirror       # mirror (no-slip ghost 2 U - u_i) | wall (U)
+ *     pressure:         { alpha: 0, gamma: 5.0e-3 }          # T-9
+ *     freeSurface:      { beta: 0.97, asymmetry: 0.2 }       # T-12 + geometric test
+ *     neighbourSkin:    0.2
+ *     lsmpsDetMin:      1.0e-2
+ *     reorderInterval:  50
+ *
+ * system/solution.yaml:
+ *
+ *     p: { solver: pcg, preconditioner: ic0, tolerance: 1e-8, maxIter: 2000,
+ *          warmStart: true, onFailure: stop }          # stop | continue
+ *     U: { solver: pcg, preconditioner: jacobi, tolerance: 1e-10, maxIter: 500 }
+ */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "io/case.h"
+#include "io/dict.h"
+#include "models/models.h"
+#include "models/transport.h"
+#include "mps/mps.h"
+#include "mps/operators.h"
+
+void lub_mps_config_defaults(lub_mps_config *c)
+{
+    memset(c, 0, sizeof *c);
+    c->re_l0 = 3.1;
+    c->gradient = LUB_GRADIENT_LSMPS;
+    c->min_pressure_shift = 1;
+    c->clip_negative = 1;
+    c->alpha = 0.0;
+    c->gamma = 0.2;
+    c->beta = 0.97;
+    c->asymmetry = 0.2;
+    c->skin = 0.2;
+    c->lsmps_det_min = LUB_MPS_LSMPS_DET_MIN;
+    c->reorder_interval = 50;
+    c->mirror_dummies = 1;
+    c->p_solver = lub_linsolver_defaults();
+    c->p_solver.pcg.tolerance = 1e-8;
+    c->p_solver.pcg.precond = LUB_PRECOND_IC0;
+    c->p_solver.pcg.warm_start = 1;
+    c->v_solver = lub_linsolver_defaults();
+    c->v_solver.pcg.tolerance = 1e-10;
+    c->v_solver.pcg.precond = LUB_PRECOND_JACOBI;
+    c->v_solver.pcg.warm_start = 1;
+    c->viscosity = LUB_VISCOSITY_NONE;
+    c->collision_distance = 0.8;
+    c->restitution = 0.2;
+}
+
+static void read_linsolver(lub_node *map, lub_linsolver_options *o, int *cont)
+{
+    static const char *const fail[] = {"stop", "continue", NULL};
+    if (!map) return;
+    o->kind = lub_dict_choice(map, "solver", lub_linsolver_choice_names, o->kind);
+    o->pcg.precond =
+        lub_dict_choice(map, "preconditioner", lub_precond_choice_names, o->pcg.precond);
+    o->pcg.tolerance =
+        lub_dict_real_or(map, "tolerance", o->pcg.tolerance, (lub_range){0.0, 1.0, 1, 1});
+    o->pcg.max_iter = (int)lub_dict_int_or(map, "maxIter", o->pcg.max_iter, 1, 100000000);
+    o->pcg.warm_start = lub_dict_bool_or(map, "warmStart", o->pcg.warm_start);
+    o->cholmod.ordering =
+        lub_dict_choice(map, "ordering", lub_cholmod_ordering_names, o->cholmod.ordering);
+    *cont = lub_dict_choice(map, "onFailure", fail, 0);
+}
+
+static void read_schemes(lub_mps_config *c, const char *path)
+{
+    static const char *const grad[] = {"standard", "lsmps", NULL};
+    static const char *const neg[] = {"keep", "clip", NULL};
+    static const char *const dummy[] = {"wall", "mirror", NULL};
+    lub_dict *d = lub_dict_read(path);
+    lub_node *r = lub_dict_root(d);
+    c->re_l0 = lub_dict_real_or(r, "effectiveRadius", 3.1, LUB_BETWEEN(1.5, 6.0));
+    c->gradient = lub_dict_choice(r, "gradient", grad, LUB_GRADIENT_LSMPS);
+    c->min_pressure_shift = lub_dict_bool_or(r, "minPressureShift", 1);
+    c->clip_negative = lub_dict_choice(r, "negativePressure", neg, 1);
+    c->mirror_dummies = lub_dict_choice(r, "dummyVelocity", dummy, c->mirror_dummies);
+    lub_node *p = lub_dict_map_or(r, "pressure");
+    c->alpha = lub_dict_real_or(p, "alpha", 0.0, LUB_NONNEGATIVE);
+    c->gamma = lub_dict_real_or(p, "gamma", 0.2, (lub_range){0.0, 1.0, 1, 0});
+    lub_node *fs = lub_dict_map_or(r, "freeSurface");
+    c->beta = lub_dict_real_or(fs, "beta", 0.97, (lub_range){0.0, 1.0, 1, 1});
+    c->asymmetry = lub_dict_real_or(fs, "asymmetry", 0.2, LUB_BETWEEN(0.0, 10.0));
+    c->skin = lub_dict_real_or(r, "neighbourSkin", 0.2, LUB_BETWEEN(0.0, 1.0));
+    c->lsmps_det_min =
+        lub_dict_real_or(r, "lsmpsDetMin", LUB_MPS_LSMPS_DET_MIN, (lub_range){0.0, 1.0, 1, 1});
+    c->reorder_interval = (int)lub_dict_int_or(r, "reorderInterval", 50, 0, 1000000);
+    lub_dict_finish(d);
+    lub_dict_free(d);
+}
+
+static void read_solution(lub_mps_config *c, const char *path)
+{
+    lub_dict *d = lub_dict_read_optional(path);
+    lub_node *r = d ? lub_dict_root(d) : NULL;
+    read_linsolver(lub_dict_map_or(r, "p"), &c->p_solver, &c->p_continue);
+    read_linsolver(lub_dict_map_or(r, "U"), &c->v_solver, &c->v_continue);
+    if (d) {
+        lub_dict_finish(d);
+        lub_dict_free(d);
+    }
+}
+
+static void read_models(lub_mps_config *c, const char *path, const lub_particles *P)
+{
+    static const char *const visc[] = {"explicit", "crankNicolson", NULL};
+    lub_dict *d = lub_dict_read_optional(path);
+    lub_node *r = d ? lub_dict_root(d) : NULL;
+    if (r) lub_models_declare(r);
+
+    lub_node *g = lub_dict_map_or(r, "gravity");
+    c->gravity = g != NULL;
+    memset(c->g, 0, sizeof c->g);
+    if (g) lub_dict_vec(g, "g", c->g, P->dim, P->dim, LUB_ANY);
+
+    /* movingWalls names patches of the particle file: present them as walls */
+    lub_geometry geo = {0};
+    lub_wall walls[LUB_MAX_PATCHES];
+    memset(walls, 0, sizeof walls);
+    geo.dim = P->dim;
+    geo.nwalls = P->npatches;
+    geo.walls = walls;
+    for (int k = 0; k < P->npatches; k++)
+        snprintf(walls[k].name, sizeof walls[k].name, "%s", P->patch_names[k]);
+    int moving[LUB_MAX_PATCHES];
+    lub_moving_walls_read(r, &geo, c->patch_velocity, moving);
+
+    lub_node *v = lub_dict_map_or(r, "viscosity");
+    c->viscosity = v ? 1 + lub_dict_choice(v, "scheme", visc, 1) : LUB_VISCOSITY_NONE;
+
+    lub_node *col = lub_dict_map_or(r, "collision");
+    c->collision = col != NULL;
+    c->collision_distance =
+        lub_dict_real_or(col, "distance", c->collision_distance, (lub_range){0.0, 1.0, 1, 0});
+    c->restitution = lub_dict_real_or(col, "restitution", c->restitution, LUB_UNIT);
+
+    const char *unsupported[] = {"elasticWall", "multiResolution"};
+    for (int k = 0; k < 2; k++) {
+        lub_node *m = lub_dict_find(r, unsupported[k]);
+        if (m)
+            lub_node_error(m,
+                           "model '%s' is not available in this version of lubFoam "
+                           "(remove it from %s)",
+                           unsupported[k], path);
+    }
+    if (d) {
+        lub_dict_finish(d);
+        lub_dict_free(d);
+    }
+}
+
+void lub_mps_config_read(lub_mps_config *c, const char *case_dir, const lub_particles *P)
+{
+    lub_case cs;
+    char path[LUB_PATH_MAX];
+    lub_mps_config_defaults(c);
+    lub_case_open(&cs, case_dir);
+    lub_transport_read(lub_case_path(&cs, path, "constant/transportProperties.yaml"), &c->rho,
+                       &c->nu);
+    read_models(c, lub_case_path(&cs, path, "constant/models.yaml"), P);
+    read_schemes(c, lub_case_path(&cs, path, "system/schemes.yaml"));
+    read_solution(c, lub_case_path(&cs, path, "system/solution.yaml"));
+}

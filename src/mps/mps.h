@@ -1,0 +1,150 @@
+/* lubkit MPS: the semi-implicit MPS solver for one resolution level (methods.md §2).
+ *
+ * The step follows the thesis (Figure 1):
+ *
+ *     1. neighbour lists at r^k (cell-linked list, kept with a skin)
+ *     2. viscosity and body force -> u*           explicit (T-7) or Crank-Nicolson (T-31)
+ *     3. temporary positions r* = r^k + u* dt      (T-8); walls move with their velocity
+ *     4. PND n* at r*                              (T-11)
+ *     5. free surface: n* < beta n0, refined by a geometric test   (T-12)
+ *     6. pressure Poisson equation                 (T-9, T-10), Dirichlet p = 0 on the surface
+ *     7. pressure gradient                         standard (T-13, T-14) or LSMPS (T-15)
+ *     8. u^{k+1} = u* - dt/rho grad p, r^{k+1} = r* + (u^{k+1} - u*) dt   (T-16, T-17)
+ *     9. collision, periodic wrap, checks
+ *
+ * Walls are one layer of wall particles (pressure solved) with dummy layers behind them (PND
+ * only).  Wall and dummy particles move with the velocity of their patch (movingWalls).
+ *
+ * Configuration comes from system/schemes.yaml, system/solution.yaml, constant/models.yaml
+ * and constant/transportProperties.yaml (lub_mps_config_read); the state is a lub_particles
+ * plus work arrays allocated once (lub_mps_init): the step never allocates.
+ */
+#ifndef LUB_MPS_MPS_H
+#define LUB_MPS_MPS_H
+
+#include <stdint.h>
+
+#include "core/timer.h"
+#include "linalg/linsolve.h"
+#include "mps/neighbours.h"
+#include "particles/particles.h"
+
+enum { LUB_GRADIENT_STANDARD = 0, LUB_GRADIENT_LSMPS = 1 };
+enum { LUB_VISCOSITY_NONE = 0, LUB_VISCOSITY_EXPLICIT = 1, LUB_VISCOSITY_CN = 2 };
+
+typedef struct {
+    /* system/schemes.yaml */
+    double re_l0;           /* re / l0 (T-6; 3.1) */
+    int gradient;           /* LUB_GRADIENT_* */
+    int min_pressure_shift; /* p_hat of T-14 */
+    int clip_negative;      /* negative pressure set to 0 after the solve */
+    double alpha, gamma;    /* T-9 */
+    double beta;            /* free surface: n* < beta n0 (T-12) */
+    double asymmetry;       /* geometric test: centroid offset / l0 above which a low-PND
+                               particle is on the surface (0: PND test only) */
+    double skin;            /* neighbour search radius re (1 + skin) */
+    double lsmps_det_min;   /* LSMPS fallback threshold */
+    int reorder_interval;   /* steps between cell-order sorts (0: never) */
+    int mirror_dummies;     /* dummies take the no-slip ghost velocity 2 U - u_i (viscosity) */
+
+    /* system/solution.yaml */
+    lub_linsolver_options p_solver, v_solver;
+    int p_continue, v_continue; /* continue the run when a solve fails */
+
+    /* constant/ */
+    double rho, nu;
+    int gravity;
+    double g[3];
+    int viscosity; /* LUB_VISCOSITY_* */
+    double patch_velocity[LUB_MAX_PATCHES][3];
+    int collision;
+    double collision_distance; /* in l0 */
+    double restitution;
+} lub_mps_config;
+
+/* The defaults of every entry (those of etc/templates/schemes.yaml and solution.yaml). */
+void lub_mps_config_defaults(lub_mps_config *c);
+/* Read the dictionaries of a case into c, checking patch names against the particles'
+ * patches.  Fatal (exit 1) with file:line on bad input.  case_dir is the case root. */
+void lub_mps_config_read(lub_mps_config *c, const char *case_dir, const lub_particles *P);
+
+/* What the last step did, for the log and the cost table. */
+typedef struct {
+    lub_solve_result p, v[3];
+    size_t nsurface, nunknowns, nfallback, nrebuild;
+    double umax; /* largest fluid speed after the step */
+} lub_mps_stats;
+
+/* Phases timed in every run (cost.dat columns). */
+enum {
+    LUB_T_NEIGHBOUR,
+    LUB_T_VISCOSITY,
+    LUB_T_ASSEMBLY,
+    LUB_T_PSOLVE,
+    LUB_T_GRADIENT,
+    LUB_T_OTHER,
+    LUB_T_OUTPUT,
+    LUB_T_COUNT
+};
+extern const char *const lub_mps_phase_names[]; /* neighbourSearch, viscositySolve, ... */
+
+typedef struct {
+    lub_mps_config c;
+    lub_particles *P;
+    int dim;
+    double l0, re, n0, lambda0;
+    double lo[3], hi[3];
+    int periodic[3];
+
+    lub_neighbours nb;
+    lub_csr A; /* pressure, then viscosity matrix */
+    lub_linsolver psolver, vsolver;
+
+    size_t cap;
+    double *us[3]; /* u* */
+    double *pnd;   /* n* */
+    uint8_t *surface;
+    int *row;              /* unknown index of a particle, -1 */
+    int *prow;             /* particle of an unknown */
+    double *b, *x;         /* right-hand side and solution (pressure) */
+    double *bv[3], *xv[3]; /* viscosity */
+    double *grad[3];
+    double *lap;
+    void *scratch;
+    long steps; /* global step count (from the particle file) */
+    int built;  /* neighbour lists built once */
+
+    lub_mps_stats st;
+    lub_timers tm;
+} lub_mps;
+
+/* Set up the solver for particles P (the state lives in P; its capacity must not change
+ * while the solver runs).  domain box and periodicity from lo/hi/periodic.  Computes re, n0
+ * and lambda0 from l0 (level 0) and writes them into P->levels[0]. */
+void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const double lo[3],
+                  const double hi[3], const int periodic[3]);
+void lub_mps_free(lub_mps *m);
+
+/* Status of a step. */
+typedef enum {
+    LUB_STEP_OK = 0,
+    LUB_STEP_SOLVE_FAILED, /* a linear solve failed and the dictionary says stop */
+    LUB_STEP_NONFINITE,    /* NaN or Inf in a particle value */
+    LUB_STEP_ESCAPED,      /* a particle left the domain through a non-periodic side */
+} lub_step_status;
+
+/* Advance by dt.  On failure, *bad is the index of the first offending particle (or -1) and
+ * msg describes it; the particle state is then undefined (the caller keeps its last good
+ * time folder). */
+lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize);
+
+/* Build the neighbour lists afresh at the next step.  The solver calls it after writing a
+ * time folder, so that a run restarted from that folder (whose lists are built afresh)
+ * repeats the uninterrupted run exactly: lists kept with a skin hold the same pairs but sum
+ * them in another order, and the iterative pressure solve would then stop at other iterates. */
+static inline void lub_mps_rebuild_lists(lub_mps *m) { m->built = 0; }
+
+/* Largest speed of all particles (fluid and moving walls). */
+double lub_mps_max_speed(const lub_mps *m);
+
+#endif

@@ -1,0 +1,606 @@
+/* lubkit MPS: cell-linked-list neighbour search (see neighbours.h). */
+#include "mps/neighbours.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "mps/weight.h"
+
+/* The cells are made this much (relative) larger than rs, so that the round-off of
+ * (x - lo) / h never puts two particles closer than rs two cells apart. */
+#define CELL_MARGIN 1e-9
+/* Arrays grow with this headroom so that a slowly growing pair count does not reallocate
+ * every step. */
+#define HEADROOM 1.25
+/* Rows shorter than this are scanned whole; longer ones are cut to an x window by bisection
+ * (see segment_window). */
+#define WINDOW_MIN 16
+
+static const char axis_name[3] = {'x', 'y', 'z'};
+
+void lub_neighbours_init(lub_neighbours *nb, int dim, double re, double skin, const double lo[3],
+                         const double hi[3], const int periodic[3])
+{
+    memset(nb, 0, sizeof *nb);
+    if (dim != 2 && dim != 3) lub_fatal("neighbour search: dimension %d, expected 2 or 3", dim);
+    if (!(re > 0) || !isfinite(re))
+        lub_fatal("neighbour search: effective radius re = %g, expected a positive number", re);
+    if (!(skin >= 0) || !isfinite(skin))
+        lub_fatal("neighbour search: skin = %g, expected a number >= 0", skin);
+    nb->dim = dim;
+    nb->re = re;
+    nb->rs = re * (1.0 + skin);
+    lub_neighbours_set_box(nb, lo, hi, periodic);
+}
+
+void lub_neighbours_set_box(lub_neighbours *nb, const double lo[3], const double hi[3],
+                            const int periodic[3])
+{
+    double ncells = 1.0;
+    for (int d = 0; d < 3; d++) {
+        if (d >= nb->dim) {
+            nb->lo[d] = 0.0, nb->hi[d] = 1.0, nb->periodic[d] = 0, nb->period[d] = 1.0;
+            nb->nc[d] = 1, nb->h[d] = 1.0, nb->inv_h[d] = 1.0;
+            continue;
+        }
+        double L = hi[d] - lo[d];
+        if (!(L > 0) || !isfinite(L))
+            lub_fatal("neighbour search: box in %c from %g to %g, expected lo < hi", axis_name[d],
+                      lo[d], hi[d]);
+        int per = periodic && periodic[d];
+        /* With a period of at least 2 rs a pair closer than rs has exactly one such image. */
+        if (per && L < 2.0 * nb->rs)
+            lub_fatal("neighbour search: the period %g in %c is shorter than twice the search "
+                      "radius 2 rs = %g",
+                      L, axis_name[d], 2.0 * nb->rs);
+        double m = floor(L / (nb->rs * (1.0 + CELL_MARGIN)));
+        if (m < 1) m = 1;
+        /* A period just above 2 rs: two cells, each the neighbour of the other (every image
+         * is then examined, so the missing margin does not matter). */
+        if (per && m < 2) m = 2;
+        if (m > 1e8) m = 1e8;
+        nb->lo[d] = lo[d], nb->hi[d] = hi[d], nb->periodic[d] = per, nb->period[d] = L;
+        nb->nc[d] = (int)m;
+        nb->h[d] = L / m;
+        nb->inv_h[d] = m / L;
+        ncells *= m;
+    }
+    if (ncells > 4.0e9)
+        lub_fatal("neighbour search: %.3g cells of size %g in the box, more than the 4e9 "
+                  "supported: is the box much larger than the particles?",
+                  ncells, nb->rs);
+    nb->ncells = (size_t)ncells;
+    if (nb->ncells + 1 > nb->cap_cells) {
+        free(nb->cell_start);
+        free(nb->cursor);
+        nb->cap_cells = nb->ncells + 1;
+        nb->cell_start = lub_malloc(nb->cap_cells * sizeof *nb->cell_start);
+        nb->cursor = lub_malloc(nb->cap_cells * sizeof *nb->cursor);
+    }
+}
+
+void lub_neighbours_free(lub_neighbours *nb)
+{
+    free(nb->start);
+    free(nb->j);
+    for (int d = 0; d < 3; d++) free(nb->dx[d]), free(nb->xs[d]);
+    free(nb->r);
+    free(nb->w);
+    free(nb->perm);
+    free(nb->cell);
+    free(nb->spos);
+    free(nb->cell_start);
+    free(nb->cursor);
+    memset(nb, 0, sizeof *nb);
+}
+
+static void reserve_particles(lub_neighbours *nb, size_t n)
+{
+    if (n > UINT32_MAX - 1)
+        lub_fatal("neighbour search: %zu particles, more than the %u supported", n,
+                  (unsigned)(UINT32_MAX - 1));
+    if (n <= nb->cap_n && nb->start) return;
+    size_t cap = (size_t)(n * HEADROOM) + 16;
+    nb->start = lub_realloc(nb->start, (cap + 1) * sizeof *nb->start);
+    nb->perm = lub_realloc(nb->perm, cap * sizeof *nb->perm);
+    nb->cell = lub_realloc(nb->cell, cap * sizeof *nb->cell);
+    nb->spos = lub_realloc(nb->spos, cap * sizeof *nb->spos);
+    for (int d = 0; d < nb->dim; d++) nb->xs[d] = lub_realloc(nb->xs[d], cap * sizeof(double));
+    nb->cap_n = cap;
+}
+
+static void reserve_pairs(lub_neighbours *nb, size_t npairs)
+{
+    if (npairs <= nb->cap_pairs && nb->j) return;
+    size_t cap = (size_t)(npairs * HEADROOM) + 64;
+    /* The old contents are not needed: free + malloc avoids copying them. */
+    free(nb->j);
+    nb->j = lub_malloc(cap * sizeof *nb->j);
+    for (int d = 0; d < nb->dim; d++) {
+        free(nb->dx[d]);
+        nb->dx[d] = lub_malloc(cap * sizeof(double));
+    }
+    free(nb->r);
+    nb->r = lub_malloc(cap * sizeof(double));
+    free(nb->w);
+    nb->w = lub_malloc(cap * sizeof(double));
+    nb->cap_pairs = cap;
+}
+
+/* Bring a coordinate of a periodic direction into [lo, lo + L); NaN stays NaN. */
+static inline double wrap(double x, double lo, double L)
+{
+    if (x >= lo && x < lo + L) return x;
+    double y = x - L * floor((x - lo) / L);
+    if (y >= lo + L) y -= L; /* round-off of the floor above */
+    if (y < lo) y = lo;
+    return y;
+}
+
+/* Cell coordinate of position x in direction d, clamped into the grid (NaN -> 0). */
+static inline int cell_coord(const lub_neighbours *nb, int d, double x)
+{
+    double t = (x - nb->lo[d]) * nb->inv_h[d];
+    if (!(t >= 0)) return 0;
+    if (t >= nb->nc[d]) return nb->nc[d] - 1;
+    return (int)t;
+}
+
+/* Position of particle i as used by the search (wrapped in periodic directions), and
+ * whether it escaped the box. */
+static inline int search_position(const lub_neighbours *nb, double *const x[3], size_t i,
+                                  double xi[3])
+{
+    int escaped = 0;
+    for (int d = 0; d < nb->dim; d++) {
+        double v = x[d][i];
+        if (nb->periodic[d]) {
+            v = wrap(v, nb->lo[d], nb->period[d]);
+            if (v != v) escaped = 1;
+        } else if (!(v >= nb->lo[d] && v <= nb->hi[d])) {
+            escaped = 1;
+        }
+        xi[d] = v;
+    }
+    /* A particle with a non-finite coordinate is put at +infinity in every direction: it
+     * keeps the cells sorted in x and is at an infinite (or NaN) distance from everyone. */
+    if (!(isfinite(xi[0]) && isfinite(xi[1]) && (nb->dim == 2 || isfinite(xi[2])))) {
+        escaped = 1;
+        for (int d = 0; d < nb->dim; d++) xi[d] = INFINITY;
+    }
+    return escaped;
+}
+
+size_t lub_neighbours_bin(lub_neighbours *nb, size_t n, double *const x[3])
+{
+    reserve_particles(nb, n);
+    nb->n = n;
+    const int dim = nb->dim;
+    const size_t nx = (size_t)nb->nc[0], ny = (size_t)nb->nc[1];
+    size_t *count = nb->cell_start;
+    memset(count, 0, (nb->ncells + 1) * sizeof *count);
+
+    /* Counting sort of the particles by cell. */
+    size_t escaped = 0;
+    for (size_t i = 0; i < n; i++) {
+        double xi[3] = {0, 0, 0};
+        escaped += (size_t)search_position(nb, x, i, xi);
+        size_t c = (size_t)cell_coord(nb, 0, xi[0]) + nx * (size_t)cell_coord(nb, 1, xi[1]);
+        if (dim == 3) c += nx * ny * (size_t)cell_coord(nb, 2, xi[2]);
+        nb->cell[i] = (uint32_t)c;
+        count[c + 1]++;
+    }
+    for (size_t c = 0; c < nb->ncells; c++) count[c + 1] += count[c];
+    memcpy(nb->cursor, nb->cell_start, nb->ncells * sizeof *nb->cursor);
+    for (size_t i = 0; i < n; i++) {
+        size_t k = nb->cursor[nb->cell[i]]++;
+        double xi[3];
+        search_position(nb, x, i, xi);
+        nb->perm[k] = (uint32_t)i;
+        for (int d = 0; d < dim; d++) nb->xs[d][k] = xi[d];
+    }
+    /* Within a cell, order by x (insertion sort, stable: nearly linear once the caller keeps
+     * its particles in cell order).  The cells of a row then hold their particles in
+     * ascending x, so the search can cut each row down to an x window. */
+    double *xs0 = nb->xs[0], *xs1 = nb->xs[1], *xs2 = nb->xs[2];
+    for (size_t c = 0; c < nb->ncells; c++) {
+        const size_t k0 = nb->cell_start[c], k1 = nb->cell_start[c + 1];
+        for (size_t k = k0 + 1; k < k1; k++) {
+            const double a0 = xs0[k];
+            if (!(a0 < xs0[k - 1])) continue;
+            const double a1 = xs1[k], a2 = dim == 3 ? xs2[k] : 0.0;
+            const uint32_t pk = nb->perm[k];
+            size_t q = k;
+            for (; q > k0 && a0 < xs0[q - 1]; q--) {
+                xs0[q] = xs0[q - 1], xs1[q] = xs1[q - 1], nb->perm[q] = nb->perm[q - 1];
+                if (dim == 3) xs2[q] = xs2[q - 1];
+            }
+            xs0[q] = a0, xs1[q] = a1, nb->perm[q] = pk;
+            if (dim == 3) xs2[q] = a2;
+        }
+    }
+    for (size_t k = 0; k < n; k++) nb->spos[nb->perm[k]] = (uint32_t)k;
+    nb->nescaped = escaped;
+    return escaped;
+}
+
+/* A run of particles in cell order (consecutive cells of one row) and the periodic shift to
+ * add to their positions. */
+typedef struct {
+    size_t k0, k1;
+    double s[3];
+    /* extent of the row in y and z, shifted; infinite on the outer side of a boundary cell
+     * of a non-periodic direction, which also holds the particles clamped into it */
+    double ylo, yhi, zlo, zhi;
+} segment;
+
+/* Extent [elo, ehi] of cell row c in direction d, shifted by s (see segment). */
+static inline void row_extent(const lub_neighbours *nb, int d, int c, double s, double *elo,
+                              double *ehi)
+{
+    if (d >= nb->dim) {
+        *elo = -INFINITY, *ehi = INFINITY;
+        return;
+    }
+    *elo = nb->lo[d] + c * nb->h[d] + s;
+    *ehi = nb->lo[d] + (c + 1) * nb->h[d] + s;
+    if (!nb->periodic[d] && c == 0) *elo = -INFINITY;
+    if (!nb->periodic[d] && c == nb->nc[d] - 1) *ehi = INFINITY;
+}
+
+/* Neighbour cell coordinate c in direction d: wrapped with its shift, or 0 if outside. */
+static inline int neighbour_coord(const lub_neighbours *nb, int d, int *c, double *s)
+{
+    *s = 0.0;
+    if (*c < 0) {
+        if (!nb->periodic[d]) return 0;
+        *c += nb->nc[d];
+        *s = -nb->period[d];
+    } else if (*c >= nb->nc[d]) {
+        if (!nb->periodic[d]) return 0;
+        *c -= nb->nc[d];
+        *s = nb->period[d];
+    }
+    return 1;
+}
+
+/* The particles of the 3^d cells around cell c as at most 27 segments (usually 3 in 2-D and
+ * 9 in 3-D: the three cells of a row are contiguous in cell order). */
+static int cell_segments(const lub_neighbours *nb, size_t c, segment *seg)
+{
+    const int nx = nb->nc[0], ny = nb->nc[1];
+    const int cx = (int)(c % (size_t)nx), cy = (int)((c / (size_t)nx) % (size_t)ny);
+    const int cz = (int)(c / ((size_t)nx * (size_t)ny));
+    const int oz = nb->dim == 3 ? 1 : 0;
+    int ns = 0;
+    for (int dz = -oz; dz <= oz; dz++) {
+        int z = cz + dz;
+        double sz, zlo, zhi;
+        if (!neighbour_coord(nb, 2, &z, &sz)) continue;
+        row_extent(nb, 2, z, sz, &zlo, &zhi);
+        for (int dy = -1; dy <= 1; dy++) {
+            int y = cy + dy;
+            double sy, ylo, yhi;
+            if (!neighbour_coord(nb, 1, &y, &sy)) continue;
+            row_extent(nb, 1, y, sy, &ylo, &yhi);
+            /* segments of one row only merge with each other: they stay sorted in x */
+            const int row_first = ns;
+            for (int dx = -1; dx <= 1; dx++) {
+                int x = cx + dx;
+                double sx;
+                if (!neighbour_coord(nb, 0, &x, &sx)) continue;
+                size_t cell = (size_t)x + (size_t)nx * ((size_t)y + (size_t)ny * (size_t)z);
+                size_t k0 = nb->cell_start[cell], k1 = nb->cell_start[cell + 1];
+                if (k0 == k1) continue;
+                if (ns > row_first && seg[ns - 1].k1 == k0 && seg[ns - 1].s[0] == sx) {
+                    seg[ns - 1].k1 = k1;
+                } else {
+                    seg[ns].k0 = k0, seg[ns].k1 = k1;
+                    seg[ns].s[0] = sx, seg[ns].s[1] = sy, seg[ns].s[2] = sz;
+                    seg[ns].ylo = ylo, seg[ns].yhi = yhi, seg[ns].zlo = zlo, seg[ns].zhi = zhi;
+                    ns++;
+                }
+            }
+        }
+    }
+    return ns;
+}
+
+/* Squared distance of candidate k from particle i, written once so that the counting and
+ * the storing sweep make the same floating-point decisions. */
+static inline double dist2(int dim, const double *const xs[3], size_t k, const double p[3],
+                           double d[3])
+{
+    d[0] = xs[0][k] + p[0], d[1] = xs[1][k] + p[1];
+    double r2 = d[0] * d[0] + d[1] * d[1];
+    if (dim == 3) d[2] = xs[2][k] + p[2], r2 += d[2] * d[2];
+    return r2;
+}
+
+/* First k in [k0, k1) with v[k] >= key (v ascending there); branch-free halving. */
+static inline size_t lower_bound(const double *v, size_t k0, size_t k1, double key)
+{
+    const double *base = v + k0;
+    size_t len = k1 - k0;
+    if (len == 0) return k0;
+    while (len > 1) {
+        const size_t half = len / 2;
+        base = base[half] < key ? base + half : base;
+        len -= half;
+    }
+    return (size_t)(base - v) + (base[0] < key);
+}
+
+/* The candidates of segment sg for a particle at xi: the whole segment when it is short,
+ * else the x window |x_k + s_x - x_i| < sqrt(rs^2 - g^2), g the distance from xi to the row
+ * in y and z (a pair in that row has |r_ij| >= g).  The window is widened by a relative
+ * 1e-9 against round-off; the distance test decides.  The window bounds are the first
+ * positions with x >= the window's ends (unique, as the segment is sorted in x), found by
+ * moving the bounds st of the previous particle of the same cell (a few steps when the
+ * particles are in cell order) or by bisection when st[0] is unset (SIZE_MAX). */
+static inline void segment_window(const lub_neighbours *nb, const segment *sg, const double xi[3],
+                                  double rs2, size_t st[2], size_t *ka, size_t *kb)
+{
+    const size_t k0 = sg->k0, k1 = sg->k1;
+    *ka = k0, *kb = k1;
+    if (k1 - k0 < WINDOW_MIN) return;
+    /* distance to the row, shrunk by 1e-9 of a cell (plain comparisons: fmax is a call) */
+    const double ty = 1e-9 * nb->h[1], tz = 1e-9 * nb->h[2];
+    double gy = sg->ylo - xi[1] > xi[1] - sg->yhi ? sg->ylo - xi[1] : xi[1] - sg->yhi;
+    double gz = sg->zlo - xi[2] > xi[2] - sg->zhi ? sg->zlo - xi[2] : xi[2] - sg->zhi;
+    gy = gy > ty ? gy - ty : 0.0, gz = gz > tz ? gz - tz : 0.0;
+    const double g2 = gy * gy + gz * gz;
+    if (!(g2 < rs2)) {
+        /* the row is out of reach (or xi is at infinity): no candidates */
+        *kb = *ka;
+        return;
+    }
+    const double a = sqrt(rs2 - g2) * (1.0 + 1e-9) + 1e-9 * nb->rs;
+    const double c = xi[0] - sg->s[0], lo = c - a, hi = c + a;
+    const double *v = nb->xs[0];
+    size_t p, q;
+    if (st[0] == SIZE_MAX) {
+        p = lower_bound(v, k0, k1, lo);
+        q = lower_bound(v, p, k1, hi);
+    } else {
+        p = st[0];
+        while (p > k0 && v[p - 1] >= lo) p--;
+        while (p < k1 && v[p] < lo) p++;
+        q = st[1] > p ? st[1] : p;
+        while (q > p && v[q - 1] >= hi) q--;
+        while (q < k1 && v[q] < hi) q++;
+    }
+    st[0] = p, st[1] = q;
+    *ka = p, *kb = q;
+}
+
+/* Count the pairs of every particle into start[i + 1].  The particle itself is among the
+ * candidates once (own cell, no shift) at distance 0 when its position is finite. */
+static void count_sweep(lub_neighbours *nb)
+{
+    const size_t n = nb->n;
+    const int dim = nb->dim;
+    const double rs2 = nb->rs * nb->rs;
+    const double *const xs[3] = {nb->xs[0], nb->xs[1], nb->xs[2]};
+#pragma omp parallel
+    {
+        segment seg[27];
+        size_t st[27][2];
+        int ns = 0;
+        size_t last_cell = (size_t)-1;
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            const size_t c = nb->cell[i], ki = nb->spos[i];
+            if (c != last_cell) {
+                ns = cell_segments(nb, c, seg), last_cell = c;
+                for (int q = 0; q < ns; q++) st[q][0] = SIZE_MAX;
+            }
+            const double xi[3] = {xs[0][ki], xs[1][ki], dim == 3 ? xs[2][ki] : 0.0};
+            size_t m = 0;
+            for (int s = 0; s < ns; s++) {
+                const double p[3] = {seg[s].s[0] - xi[0], seg[s].s[1] - xi[1], seg[s].s[2] - xi[2]};
+                size_t ka, kb;
+                segment_window(nb, &seg[s], xi, rs2, st[s], &ka, &kb);
+#pragma omp simd reduction(+ : m)
+                for (size_t k = ka; k < kb; k++) {
+                    double d[3];
+                    m += dist2(dim, xs, k, p, d) < rs2;
+                }
+            }
+            double d[3];
+            const double p0[3] = {-xi[0], -xi[1], -xi[2]};
+            nb->start[i + 1] = m - (dist2(dim, xs, ki, p0, d) < rs2);
+        }
+    }
+}
+
+/* Store the pairs, one segment at a time: first the sorted index k of every candidate is
+ * written at the next free place, which advances only for a pair (no unpredictable branch;
+ * the write is skipped once the particle's range is full, so a thread never writes into
+ * another particle's range); then the segment's new pairs get their displacement, distance,
+ * (T-6) weight and particle index. */
+static void fill_sweep(lub_neighbours *nb)
+{
+    const size_t n = nb->n;
+    const int dim = nb->dim;
+    const double rs2 = nb->rs * nb->rs, re = nb->re;
+    const double *const xs[3] = {nb->xs[0], nb->xs[1], nb->xs[2]};
+    uint32_t *restrict J = nb->j;
+    const uint32_t *restrict perm = nb->perm;
+    double *restrict DX = nb->dx[0], *restrict DY = nb->dx[1], *restrict DZ = nb->dx[2];
+    double *restrict R = nb->r, *restrict W = nb->w;
+    int mismatch = 0;
+#pragma omp parallel reduction(| : mismatch)
+    {
+        segment seg[27];
+        size_t st[27][2];
+        int ns = 0;
+        size_t last_cell = (size_t)-1;
+#pragma omp for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            const size_t c = nb->cell[i], ki = nb->spos[i];
+            if (c != last_cell) {
+                ns = cell_segments(nb, c, seg), last_cell = c;
+                for (int q = 0; q < ns; q++) st[q][0] = SIZE_MAX;
+            }
+            const double xi[3] = {xs[0][ki], xs[1][ki], dim == 3 ? xs[2][ki] : 0.0};
+            const size_t end = nb->start[i + 1];
+            size_t m = nb->start[i];
+            for (int s = 0; s < ns; s++) {
+                const double p[3] = {seg[s].s[0] - xi[0], seg[s].s[1] - xi[1], seg[s].s[2] - xi[2]};
+                const size_t ms = m;
+                size_t ka, kb;
+                segment_window(nb, &seg[s], xi, rs2, st[s], &ka, &kb);
+                for (size_t k = ka; k < kb; k++) {
+                    double d[3];
+                    const double r2 = dist2(dim, xs, k, p, d);
+                    if (m < end) J[m] = (uint32_t)k;
+                    m += (r2 < rs2) & (k != ki);
+                }
+                const size_t me = m < end ? m : end;
+                for (size_t q = ms; q < me; q++) {
+                    const size_t k = J[q];
+                    double d[3];
+                    const double r = sqrt(dist2(dim, xs, k, p, d));
+                    DX[q] = d[0], DY[q] = d[1];
+                    if (dim == 3) DZ[q] = d[2];
+                    R[q] = r;
+                    W[q] = lub_mps_weight(r, re);
+                    J[q] = perm[k];
+                }
+            }
+            if (m != end) mismatch = 1;
+        }
+    }
+    if (mismatch) lub_bug("neighbour search: the counting and storing sweeps disagree");
+}
+
+size_t lub_neighbours_build(lub_neighbours *nb, size_t n, double *const x[3])
+{
+    size_t escaped = lub_neighbours_bin(nb, n, x);
+    /* Two sweeps (count, then store) keep the lists in one contiguous CSR array in the
+     * particle order, whatever the number of threads. */
+    nb->start[0] = 0;
+    count_sweep(nb);
+    for (size_t i = 0; i < n; i++) nb->start[i + 1] += nb->start[i];
+    nb->npairs = nb->start[n];
+    reserve_pairs(nb, nb->npairs);
+    fill_sweep(nb);
+    return escaped;
+}
+
+/* Minimum image of a coordinate difference v for period L (L = 0: not periodic).  Positions
+ * kept within the box need at most one period added or removed; the floor is the rare
+ * fallback for positions further out. */
+static inline double min_image(double v, double L)
+{
+    if (L == 0.0) return v;
+    const double half = 0.5 * L;
+    if (v > half) {
+        v -= L;
+        if (v > half) v -= L * floor(v / L + 0.5);
+    } else if (v < -half) {
+        v += L;
+        if (v < -half) v -= L * floor(v / L + 0.5);
+    }
+    return v;
+}
+
+/* Pairs of particle i at the new positions; dim is a literal at the call sites so that the
+ * component loops unroll. */
+static inline void update_particle(lub_neighbours *nb, double *const x[3], size_t i,
+                                   const double L[3], const int dim)
+{
+    const double re = nb->re;
+    const double xi[3] = {x[0][i], x[1][i], dim == 3 ? x[2][i] : 0.0};
+    for (size_t k = nb->start[i]; k < nb->start[i + 1]; k++) {
+        const size_t j = nb->j[k];
+        double r2 = 0.0;
+        for (int d = 0; d < dim; d++) {
+            const double v = min_image(x[d][j] - xi[d], L[d]);
+            nb->dx[d][k] = v;
+            r2 += v * v;
+        }
+        const double r = sqrt(r2);
+        nb->r[k] = r;
+        nb->w[k] = lub_mps_weight(r, re);
+    }
+}
+
+size_t lub_neighbours_update(lub_neighbours *nb, double *const x[3])
+{
+    const size_t n = nb->n;
+    const int dim = nb->dim;
+    const double lim = 0.5 * (nb->rs - nb->re);
+    double L[3];
+    for (int d = 0; d < 3; d++) L[d] = d < dim && nb->periodic[d] ? nb->period[d] : 0.0;
+    size_t moved = 0;
+#pragma omp parallel for schedule(static) reduction(+ : moved)
+    for (size_t i = 0; i < n; i++) {
+        /* displacement since the build (positions then: xs, wrapped), minimum image */
+        double d2 = 0.0;
+        for (int d = 0; d < dim; d++) {
+            const double v = min_image(x[d][i] - nb->xs[d][nb->spos[i]], L[d]);
+            d2 += v * v;
+        }
+        if (!(d2 <= lim * lim)) moved++;
+        if (dim == 2)
+            update_particle(nb, x, i, L, 2);
+        else
+            update_particle(nb, x, i, L, 3);
+    }
+    return moved;
+}
+
+void lub_reorder(size_t n, const uint32_t *perm, void *scratch, void *a, size_t elsize)
+{
+    if (!a || n == 0) return;
+    /* Element types by size so that the gather compiles to plain loads and stores. */
+    switch (elsize) {
+    case 1: {
+        const uint8_t *src = a;
+        uint8_t *dst = scratch;
+#pragma omp parallel for schedule(static) if (n > 20000)
+        for (size_t k = 0; k < n; k++) dst[k] = src[perm[k]];
+        break;
+    }
+    case 2: {
+        const uint16_t *src = a;
+        uint16_t *dst = scratch;
+#pragma omp parallel for schedule(static) if (n > 20000)
+        for (size_t k = 0; k < n; k++) dst[k] = src[perm[k]];
+        break;
+    }
+    case 4: {
+        const uint32_t *src = a;
+        uint32_t *dst = scratch;
+#pragma omp parallel for schedule(static) if (n > 20000)
+        for (size_t k = 0; k < n; k++) dst[k] = src[perm[k]];
+        break;
+    }
+    case 8: {
+        /* doubles and 64-bit integers alike: copied as bytes, no aliasing issue */
+        const unsigned char *src = a;
+        unsigned char *dst = scratch;
+#pragma omp parallel for schedule(static) if (n > 20000)
+        for (size_t k = 0; k < n; k++) memcpy(dst + 8 * k, src + 8 * (size_t)perm[k], 8);
+        break;
+    }
+    default: {
+        const unsigned char *src = a;
+        unsigned char *dst = scratch;
+        for (size_t k = 0; k < n; k++)
+            memcpy(dst + elsize * k, src + elsize * (size_t)perm[k], elsize);
+    }
+    }
+    memcpy(a, scratch, n * elsize);
+}
+
+void lub_reorder_set(size_t n, const uint32_t *perm, void *scratch, int count, void *const *arrays,
+                     const size_t *elsize)
+{
+    for (int m = 0; m < count; m++)
+        if (arrays[m]) lub_reorder(n, perm, scratch, arrays[m], elsize[m]);
+}

@@ -1,0 +1,112 @@
+/* lubkit MPS: neighbour search with a cell-linked list (methods.md §2 step 1).
+ *
+ * Usage, once per time step (no allocation once the arrays have grown to the run's size):
+ *
+ *     lub_neighbours nb;
+ *     lub_neighbours_init(&nb, dim, re, skin, lo, hi, periodic);     once
+ *     ...
+ *     size_t escaped = lub_neighbours_build(&nb, n, P->x);            every step
+ *     for (size_t i = 0; i < nb.n; i++)
+ *         for (size_t k = nb.start[i]; k < nb.start[i + 1]; k++)
+ *             j = nb.j[k], r_ij = (nb.dx[0][k], nb.dx[1][k], nb.dx[2][k]), |r_ij| = nb.r[k],
+ *             w_ij = nb.w[k]
+ *     lub_neighbours_free(&nb);                                       at the end
+ *
+ * Lists are full (j is in i's list and i in j's), in the caller's particle order (CSR: the
+ * neighbours of i are entries start[i] .. start[i+1]-1), each list ordered by neighbouring
+ * cell, then by index within a cell: nearly ascending j once the particles are in cell order.  r_ij
+ * = r_j - r_i is the minimum-image displacement in periodic directions.  Pairs are those with
+ * |r_ij| < rs = re (1 + skin); w_ij = w(|r_ij|, re) (weight.h), so pairs beyond re (possible only
+ * with skin > 0) are stored with w = 0.  The operators form |r_ij|^2 from r_ij rather than reading
+ * r (the sweeps are memory-bound).
+ *
+ * Cell order for cache locality: after lub_neighbours_bin (or _build), perm[k] is the index
+ * of the k-th particle in cell order.  To sort the caller's structure-of-arrays data:
+ *
+ *     lub_neighbours_bin(&nb, n, x);
+ *     lub_reorder(n, nb.perm, scratch, x[0], sizeof(double)); ... for every per-particle array
+ *     lub_neighbours_build(&nb, n, x);                   (the lists refer to the new order)
+ *
+ * Sorting every few tens of steps is enough: particles move far less than a cell per step.
+ *
+ * Box: cells cover [lo, hi] in each direction.  A periodic direction has period hi - lo,
+ * which must be at least 2 rs (so that the pair image within rs is unique); particles
+ * outside [lo, hi) there are wrapped for the search (the caller's arrays are not modified).
+ * Particles outside a non-periodic direction's [lo, hi] (or with a non-finite coordinate)
+ * are clamped into the boundary cells: the search stays exact for them (clamping never
+ * separates two particles closer than rs by more than one cell), only slower if many pile
+ * up, and they are counted in the return value and in nb.nescaped so that the solver can
+ * stop the run.  A particle with a NaN or infinite coordinate has no neighbours.
+ *
+ * OpenMP over particles; the lists do not depend on the number of threads.
+ */
+#ifndef LUB_MPS_NEIGHBOURS_H
+#define LUB_MPS_NEIGHBOURS_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+typedef struct {
+    int dim;   /* 2 or 3 */
+    double re; /* effective radius of the weight */
+    double rs; /* search radius re (1 + skin) */
+    double lo[3], hi[3];
+    int periodic[3];
+    double period[3]; /* hi - lo */
+
+    /* cell grid (row-major, x fastest); unused directions have one cell */
+    int nc[3];
+    double h[3], inv_h[3]; /* cell size >= rs */
+    size_t ncells;
+
+    /* results of the last build */
+    size_t n;        /* particles */
+    size_t npairs;   /* entries in the lists (each pair twice) */
+    size_t *start;   /* [n + 1] */
+    uint32_t *j;     /* [npairs] neighbour index */
+    double *dx[3];   /* [npairs] r_j - r_i, minimum image; dx[2] is NULL in 2-D */
+    double *r;       /* [npairs] |r_ij| */
+    double *w;       /* [npairs] w(|r_ij|, re) */
+    uint32_t *perm;  /* [n] cell order: perm[k] = index of the k-th particle */
+    size_t nescaped; /* particles outside the box in a non-periodic direction, or non-finite */
+
+    /* internal */
+    uint32_t *cell;     /* [n] cell of particle i */
+    uint32_t *spos;     /* [n] position of particle i in cell order */
+    double *xs[3];      /* [n] positions (wrapped) in cell order */
+    size_t *cell_start; /* [ncells + 1] */
+    size_t *cursor;     /* [ncells] */
+    size_t cap_n, cap_pairs, cap_cells;
+} lub_neighbours;
+
+/* Set up an empty search structure.  skin >= 0 enlarges the search radius for
+ * lub_neighbours_update (0: lists hold exactly the pairs closer than re).  Bad values (re
+ * not positive, lo >= hi, a period shorter than 2 rs) are fatal input errors. */
+void lub_neighbours_init(lub_neighbours *nb, int dim, double re, double skin, const double lo[3],
+                         const double hi[3], const int periodic[3]);
+/* Change the box (keeps the arrays; same checks as init). */
+void lub_neighbours_set_box(lub_neighbours *nb, const double lo[3], const double hi[3],
+                            const int periodic[3]);
+void lub_neighbours_free(lub_neighbours *nb);
+
+/* Sort particles into cells: fills cell, perm, and the cell-ordered positions.  x[d][i] are
+ * the position components (x[2] unused in 2-D, may be NULL); not modified.  Returns the
+ * number of escaped particles. */
+size_t lub_neighbours_bin(lub_neighbours *nb, size_t n, double *const x[3]);
+/* Bin, then build the lists.  Returns the number of escaped particles. */
+size_t lub_neighbours_build(lub_neighbours *nb, size_t n, double *const x[3]);
+/* Recompute dx, r and w of the stored pairs for moved positions x of the same particles in
+ * the same order, e.g. the PND at the temporary positions (T-11) without a new search.  The
+ * lists still hold every pair closer than re while each particle has moved less than
+ * skin re / 2 since the build; returns the number of particles that moved further (0: the
+ * lists are complete; otherwise rebuild). */
+size_t lub_neighbours_update(lub_neighbours *nb, double *const x[3]);
+
+/* Apply a permutation to one per-particle array of n elements of elsize bytes:
+ * a_new[k] = a_old[perm[k]].  scratch holds at least n * elsize bytes. */
+void lub_reorder(size_t n, const uint32_t *perm, void *scratch, void *a, size_t elsize);
+/* The same for count arrays (arrays[m] with element size elsize[m]; NULL entries skipped). */
+void lub_reorder_set(size_t n, const uint32_t *perm, void *scratch, int count, void *const *arrays,
+                     const size_t *elsize);
+
+#endif

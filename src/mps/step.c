@@ -1,0 +1,563 @@
+/* lubkit MPS: one semi-implicit MPS step for one resolution level (see mps.h). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "mps/mps.h"
+#include "mps/operators.h"
+
+const char *const lub_mps_phase_names[] = {
+    "neighbourSearch", "viscositySolve", "assembly", "pressureSolve",
+    "gradient",        "other",          "output",   NULL};
+
+/* Operator masks: particles take part by kind (particles.h: fluid 0, wall 1, dummy 2). */
+#define K_FLUID LUB_MPS_KIND(LUB_FLUID)
+#define K_WALL  LUB_MPS_KIND(LUB_WALL)
+#define K_DUMMY LUB_MPS_KIND(LUB_DUMMY)
+
+static void *alloc_doubles(size_t n)
+{
+    return lub_calloc(n ? n : 1, sizeof(double));
+}
+
+void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const double lo[3],
+                  const double hi[3], const int periodic[3])
+{
+    memset(m, 0, sizeof *m);
+    m->c = *c;
+    m->P = P;
+    m->dim = P->dim;
+    if (P->nlevels > 1)
+        lub_fatal("the particles have %d resolution levels: multi-resolution is not available "
+                  "in this version of lubFoam",
+                  P->nlevels);
+    m->l0 = P->levels[0].l0;
+    if (!(m->l0 > 0)) lub_fatal("particle file has no valid l0 for level 0");
+    m->re = c->re_l0 * m->l0;
+    m->steps = P->step;
+    lub_mps_reference(m->dim, m->l0, m->re, &m->n0, &m->lambda0);
+    P->levels[0].re = m->re;
+    P->levels[0].n0 = m->n0;
+    P->levels[0].lambda0 = m->lambda0;
+    for (int d = 0; d < 3; d++) {
+        m->lo[d] = lo[d];
+        m->hi[d] = hi[d];
+        m->periodic[d] = periodic[d];
+    }
+    lub_neighbours_init(&m->nb, m->dim, m->re, c->skin, lo, hi, periodic);
+    lub_csr_init(&m->A);
+    lub_linsolver_init(&m->psolver, &c->p_solver);
+    lub_linsolver_init(&m->vsolver, &c->v_solver);
+
+    size_t n = P->n;
+    m->cap = n;
+    for (int d = 0; d < 3; d++) {
+        m->us[d] = alloc_doubles(n);
+        m->bv[d] = alloc_doubles(n);
+        m->xv[d] = alloc_doubles(n);
+        m->grad[d] = alloc_doubles(n);
+    }
+    m->pnd = alloc_doubles(n);
+    m->lap = alloc_doubles(n);
+    m->b = alloc_doubles(n);
+    m->x = alloc_doubles(n);
+    m->surface = lub_calloc(n ? n : 1, 1);
+    m->row = lub_calloc(n ? n : 1, sizeof *m->row);
+    m->prow = lub_calloc(n ? n : 1, sizeof *m->prow);
+    m->scratch = lub_malloc((n ? n : 1) * sizeof(double));
+    for (int k = 0; k < LUB_T_COUNT; k++) lub_timers_add(&m->tm, lub_mps_phase_names[k]);
+}
+
+void lub_mps_free(lub_mps *m)
+{
+    for (int d = 0; d < 3; d++) {
+        free(m->us[d]);
+        free(m->bv[d]);
+        free(m->xv[d]);
+        free(m->grad[d]);
+    }
+    free(m->pnd);
+    free(m->lap);
+    free(m->b);
+    free(m->x);
+    free(m->surface);
+    free(m->row);
+    free(m->prow);
+    free(m->scratch);
+    lub_neighbours_free(&m->nb);
+    lub_csr_free(&m->A);
+    lub_linsolver_free(&m->psolver);
+    lub_linsolver_free(&m->vsolver);
+}
+
+/* Sort every per-particle array into cell order (cache locality of the neighbour loops). */
+static void reorder(lub_mps *m)
+{
+    lub_particles *P = m->P;
+    double *x[3] = {P->x[0], P->x[1], P->x[2]};
+    lub_neighbours_bin(&m->nb, P->n, x);
+    void *arrays[12 + LUB_MAX_EXTRA];
+    size_t sizes[12 + LUB_MAX_EXTRA];
+    int k = 0;
+    for (int d = 0; d < 3; d++) {
+        arrays[k] = P->x[d], sizes[k++] = sizeof(double);
+        arrays[k] = P->u[d], sizes[k++] = sizeof(double);
+    }
+    arrays[k] = P->p, sizes[k++] = sizeof(double);
+    arrays[k] = P->kind, sizes[k++] = sizeof *P->kind;
+    arrays[k] = P->patch, sizes[k++] = sizeof *P->patch;
+    arrays[k] = P->level, sizes[k++] = sizeof *P->level;
+    arrays[k] = P->id, sizes[k++] = sizeof *P->id;
+    for (int e = 0; e < P->nextra; e++) arrays[k] = P->extra[e].v, sizes[k++] = sizeof(double);
+    lub_reorder_set(P->n, m->nb.perm, m->scratch, k, arrays, sizes);
+}
+
+static void neighbours(lub_mps *m, int rebuild)
+{
+    lub_particles *P = m->P;
+    double *x[3] = {P->x[0], P->x[1], P->x[2]};
+    lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
+    if (!rebuild && lub_neighbours_update(&m->nb, x) != 0) rebuild = 1;
+    if (rebuild) {
+        lub_neighbours_build(&m->nb, P->n, x);
+        m->st.nrebuild++;
+    }
+    lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
+}
+
+/* Viscosity and body force -> u* (T-7 explicit, T-31 Crank-Nicolson).  Wall and dummy
+ * particles keep their prescribed velocity and act as Dirichlet values.
+ *
+ * dummy_velocity: wall particles lie on the wall and carry its velocity U.  Dummy particles
+ * lie behind it, where the no-slip profile continued through the wall is 2 U - u (mirror
+ * image), not U; giving them U makes the wall partly slip (Poiseuille flow comes out with a
+ * slip velocity of a few percent of u_max).  With `dummyVelocity: mirror` (default) a dummy
+ * j seen from fluid particle i takes the ghost value 2 U_j - u_i, i.e. the pair term
+ * w_ij (u_j - u_i) becomes 2 w_ij (U_j - u_i); `wall` keeps U_j. */
+static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
+{
+    lub_particles *P = m->P;
+    const size_t n = P->n;
+    const int dim = m->dim;
+    const double *g = m->c.g;
+    lub_timer_start(&m->tm, LUB_T_VISCOSITY);
+    for (int d = 0; d < 3; d++) memcpy(m->us[d], P->u[d], n * sizeof(double));
+    if (m->c.viscosity == LUB_VISCOSITY_EXPLICIT) {
+        /* (T-3, T-7) with the dummy particles' ghost velocity (see dummy_velocity) */
+        const double cl = 2.0 * dim / (m->lambda0 * m->n0), nu = m->c.nu;
+        const lub_neighbours *nb = &m->nb;
+        const double gm = m->c.mirror_dummies ? 2.0 : 1.0;
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            if (P->kind[i] != LUB_FLUID) continue;
+            double acc[3] = {0, 0, 0};
+            for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+                double w = nb->w[q];
+                size_t j = nb->j[q];
+                double f = P->kind[j] == LUB_DUMMY ? gm : 1.0;
+                for (int d = 0; d < dim; d++) acc[d] += f * w * (P->u[d][j] - P->u[d][i]);
+            }
+            for (int d = 0; d < dim; d++) m->us[d][i] += dt * (nu * cl * acc[d] + g[d]);
+        }
+    } else if (m->c.viscosity == LUB_VISCOSITY_CN) {
+        /* (T-31): u*_i - (dt nu/2) <lap u*>_i = u_i + (dt nu/2) <lap u^k>_i + dt g, with the
+         * wall and dummy velocities known.  Rows: fluid particles; symmetric since w_ij is. */
+        const double k = 0.5 * dt * m->c.nu * 2.0 * dim / (m->lambda0 * m->n0);
+        const lub_neighbours *nb = &m->nb;
+        const double gm = m->c.mirror_dummies ? 2.0 : 1.0;
+        int nf = 0;
+        for (size_t i = 0; i < n; i++) {
+            m->row[i] = P->kind[i] == LUB_FLUID ? nf : -1;
+            if (P->kind[i] == LUB_FLUID) m->prow[nf++] = (int)i;
+        }
+        lub_csr_begin(&m->A, nf);
+#pragma omp parallel for schedule(static)
+        for (int r = 0; r < nf; r++) {
+            size_t i = (size_t)m->prow[r];
+            int len = 1;
+            for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++)
+                if (nb->w[q] > 0 && m->row[nb->j[q]] >= 0) len++;
+            lub_csr_set_row_length(&m->A, r, len);
+        }
+        lub_csr_alloc(&m->A);
+#pragma omp parallel for schedule(static)
+        for (int r = 0; r < nf; r++) {
+            size_t i = (size_t)m->prow[r];
+            int *col = lub_csr_row_col(&m->A, r);
+            double *val = lub_csr_row_val(&m->A, r);
+            double wsum = 0, rhs[3] = {0, 0, 0};
+            int e = 1;
+            for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+                double w = nb->w[q];
+                if (w <= 0) continue;
+                size_t j = nb->j[q];
+                /* a dummy's ghost velocity 2 U_j - u_i doubles its weight (dummy_velocity) */
+                double f = P->kind[j] == LUB_DUMMY ? gm : 1.0;
+                wsum += f * w;
+                for (int d = 0; d < dim; d++) rhs[d] += f * w * (P->u[d][j] - P->u[d][i]);
+                if (m->row[j] >= 0) {
+                    col[e] = m->row[j];
+                    val[e++] = -k * w;
+                } else {
+                    for (int d = 0; d < dim; d++) rhs[d] += f * w * P->u[d][j];
+                }
+            }
+            col[0] = r;
+            val[0] = 1.0 + k * wsum;
+            for (int d = 0; d < dim; d++) {
+                m->bv[d][r] = P->u[d][i] + k * rhs[d] + dt * g[d];
+                m->xv[d][r] = P->u[d][i]; /* initial guess */
+            }
+        }
+        lub_csr_finish(&m->A);
+        const double *b[3] = {m->bv[0], m->bv[1], m->bv[2]};
+        double *x[3] = {m->xv[0], m->xv[1], m->xv[2]};
+        lub_solve_status s = lub_linsolver_solve(&m->vsolver, &m->A, dim, b, x, m->st.v);
+        if (s != LUB_SOLVE_OK && !m->c.v_continue) {
+            char d[256];
+            for (int c = 0; c < dim; c++)
+                if (m->st.v[c].status != LUB_SOLVE_OK) {
+                    lub_solve_result_describe(&m->st.v[c], d, sizeof d);
+                    snprintf(msg, msgsize, "viscosity solve (component %d) failed: %s", c, d);
+                    break;
+                }
+            lub_timer_stop(&m->tm, LUB_T_VISCOSITY);
+            return -1;
+        }
+        for (int d = 0; d < dim; d++)
+#pragma omp parallel for schedule(static)
+            for (int r = 0; r < nf; r++) m->us[d][m->prow[r]] = m->xv[d][r];
+    } else if (m->c.gravity) {
+        for (int d = 0; d < dim; d++)
+#pragma omp parallel for schedule(static)
+            for (size_t i = 0; i < n; i++)
+                if (P->kind[i] == LUB_FLUID) m->us[d][i] += dt * g[d];
+    }
+    lub_timer_stop(&m->tm, LUB_T_VISCOSITY);
+    return 0;
+}
+
+/* Free surface (T-12): n* < beta n0, kept only when the neighbourhood is one-sided: the
+ * weighted centroid of the neighbours is further than `asymmetry` l0 from the particle.
+ * This geometric refinement plays the role of the thesis' virtual-light test: an interior
+ * particle whose PND dropped (a transient rarefaction) has neighbours all around it. */
+static void free_surface(lub_mps *m)
+{
+    lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    const size_t n = P->n;
+    const double lim = m->c.beta * m->n0, asym = m->c.asymmetry * m->l0;
+    size_t ns = 0;
+#pragma omp parallel for schedule(static) reduction(+ : ns)
+    for (size_t i = 0; i < n; i++) {
+        uint8_t s = 0;
+        if (P->kind[i] != LUB_DUMMY) {
+            double c[3] = {0, 0, 0}, wsum = 0, wpres = 0;
+            for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+                double w = nb->w[q];
+                wsum += w;
+                if (P->kind[nb->j[q]] != LUB_DUMMY) wpres += w;
+                for (int d = 0; d < m->dim; d++) c[d] += w * nb->dx[d][q];
+            }
+            if (wpres <= 0) {
+                s = 1; /* no pressure neighbour: nothing to couple to */
+            } else if (m->pnd[i] < lim) {
+                double off = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) / wsum;
+                s = (asym <= 0 || off > asym);
+            }
+        }
+        m->surface[i] = s;
+        ns += s;
+    }
+    m->st.nsurface = ns;
+}
+
+/* Pressure Poisson equation (T-9, T-10), negated so that the matrix is symmetric positive
+ * definite: c sum_j w_ij (P_i - P_j) + alpha P_i = gamma rho / dt^2 (n*_i - n0) / n0,
+ * c = 2d / (lambda0 n0), over fluid and wall particles; surface particles are Dirichlet
+ * (P = 0), dummy particles carry no pressure. */
+static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
+{
+    lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    const size_t n = P->n;
+    const double c = 2.0 * m->dim / (m->lambda0 * m->n0);
+    const double src = m->c.gamma * m->c.rho / (dt * dt) / m->n0;
+    const double alpha = m->c.alpha;
+
+    lub_timer_start(&m->tm, LUB_T_ASSEMBLY);
+    int nu = 0;
+    for (size_t i = 0; i < n; i++) {
+        int unknown = P->kind[i] != LUB_DUMMY && !m->surface[i];
+        m->row[i] = unknown ? nu : -1;
+        if (unknown) m->prow[nu++] = (int)i;
+    }
+    m->st.nunknowns = (size_t)nu;
+    if (nu > 0 && m->st.nsurface == 0 && alpha == 0) {
+        lub_timer_stop(&m->tm, LUB_T_ASSEMBLY);
+        snprintf(msg, msgsize,
+                 "the pressure equation has no Dirichlet particle (no free surface) and "
+                 "alpha = 0, so it is singular: set pressure.alpha > 0 in system/schemes.yaml "
+                 "for a closed domain");
+        return -1;
+    }
+    lub_csr_begin(&m->A, nu);
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < nu; r++) {
+        size_t i = (size_t)m->prow[r];
+        int len = 1;
+        for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++)
+            if (nb->w[q] > 0 && m->row[nb->j[q]] >= 0) len++;
+        lub_csr_set_row_length(&m->A, r, len);
+    }
+    lub_csr_alloc(&m->A);
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < nu; r++) {
+        size_t i = (size_t)m->prow[r];
+        int *col = lub_csr_row_col(&m->A, r);
+        double *val = lub_csr_row_val(&m->A, r);
+        double wsum = 0;
+        int e = 1;
+        for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+            double w = nb->w[q];
+            size_t j = nb->j[q];
+            if (w <= 0 || P->kind[j] == LUB_DUMMY) continue;
+            wsum += w;
+            if (m->row[j] >= 0) {
+                col[e] = m->row[j];
+                val[e++] = -c * w;
+            }
+        }
+        col[0] = r;
+        val[0] = c * wsum + alpha;
+        m->b[r] = src * (m->pnd[i] - m->n0);
+        m->x[r] = P->p[i]; /* warm start from the previous pressure */
+    }
+    lub_csr_finish(&m->A);
+    lub_timer_stop(&m->tm, LUB_T_ASSEMBLY);
+
+    lub_timer_start(&m->tm, LUB_T_PSOLVE);
+    const double *b = m->b;
+    double *x = m->x;
+    lub_solve_status s =
+        nu > 0 ? lub_linsolver_solve(&m->psolver, &m->A, 1, &b, &x, &m->st.p) : LUB_SOLVE_OK;
+    lub_timer_stop(&m->tm, LUB_T_PSOLVE);
+    if (s != LUB_SOLVE_OK && !m->c.p_continue) {
+        char d[256];
+        lub_solve_result_describe(&m->st.p, d, sizeof d);
+        snprintf(msg, msgsize, "pressure solve failed: %s", d);
+        if (s == LUB_SOLVE_NOT_POSDEF && m->st.p.column >= 0 && m->st.p.column < nu) {
+            size_t i = (size_t)m->prow[m->st.p.column];
+            size_t len = strlen(msg);
+            snprintf(msg + len, msgsize - len, " (particle id %llu at %g %g)",
+                     (unsigned long long)P->id[i], P->x[0][i], P->x[1][i]);
+        }
+        return -1;
+    }
+    const int clip = m->c.clip_negative;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        double p = m->row[i] >= 0 ? m->x[m->row[i]] : 0.0;
+        P->p[i] = (clip && p < 0) ? 0.0 : p;
+    }
+    return 0;
+}
+
+/* Collision (methods.md §2 step 7): a fluid particle closer than the collision distance to
+ * another particle and approaching it loses the approaching part of the relative normal
+ * velocity, with restitution e: half of (1 + e) of it against a fluid particle (equal
+ * masses), all of it against a wall or dummy particle (infinite mass).  Each particle's
+ * change is computed from the velocities before the collision step, so the result does not
+ * depend on the order or the number of threads. */
+static void collision(lub_mps *m, double dt)
+{
+    lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    const size_t n = P->n;
+    const double dc = m->c.collision_distance * m->l0, e = m->c.restitution;
+    double *du[3] = {m->grad[0], m->grad[1], m->grad[2]};
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        double acc[3] = {0, 0, 0};
+        if (P->kind[i] == LUB_FLUID) {
+            for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+                double r = nb->r[q];
+                if (r >= dc || r <= 0) continue;
+                size_t j = nb->j[q];
+                double vn = 0, ev[3] = {0, 0, 0};
+                for (int d = 0; d < m->dim; d++) {
+                    ev[d] = nb->dx[d][q] / r;
+                    vn += (P->u[d][i] - P->u[d][j]) * ev[d];
+                }
+                if (vn <= 0) continue; /* separating */
+                double f = P->kind[j] == LUB_FLUID ? 0.5 * (1 + e) : (1 + e);
+                for (int d = 0; d < m->dim; d++) acc[d] -= f * vn * ev[d];
+            }
+        }
+        for (int d = 0; d < 3; d++) du[d][i] = acc[d];
+    }
+    for (int d = 0; d < m->dim; d++)
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            P->u[d][i] += du[d][i];
+            P->x[d][i] += du[d][i] * dt;
+        }
+}
+
+/* Wrap periodic coordinates into [lo, hi). */
+static void wrap(lub_mps *m)
+{
+    lub_particles *P = m->P;
+    for (int d = 0; d < m->dim; d++) {
+        if (!m->periodic[d]) continue;
+        const double lo = m->lo[d], L = m->hi[d] - m->lo[d];
+        double *x = P->x[d];
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < P->n; i++) {
+            if (x[i] < lo || x[i] >= lo + L) {
+                x[i] = lo + fmod(x[i] - lo, L);
+                if (x[i] < lo) x[i] += L;
+                if (x[i] >= lo + L) x[i] -= L; /* fmod of a tiny negative */
+            }
+        }
+    }
+}
+
+static const char *kind_name(int k)
+{
+    return k == LUB_FLUID ? "fluid" : k == LUB_WALL ? "wall" : "dummy";
+}
+
+/* First particle with a non-finite value, or outside the box in a non-periodic direction. */
+static lub_step_status check(lub_mps *m, long *bad, char *msg, size_t msgsize)
+{
+    lub_particles *P = m->P;
+    for (size_t i = 0; i < P->n; i++) {
+        int finite = isfinite(P->p[i]);
+        for (int d = 0; d < m->dim; d++) finite &= isfinite(P->x[d][i]) && isfinite(P->u[d][i]);
+        if (!finite) {
+            *bad = (long)i;
+            snprintf(msg, msgsize,
+                     "non-finite value at %s particle id %llu: position (%g, %g), velocity "
+                     "(%g, %g), pressure %g",
+                     kind_name(P->kind[i]), (unsigned long long)P->id[i], P->x[0][i], P->x[1][i],
+                     P->u[0][i], P->u[1][i], P->p[i]);
+            return LUB_STEP_NONFINITE;
+        }
+        for (int d = 0; d < m->dim; d++) {
+            if (m->periodic[d]) continue;
+            if (P->x[d][i] < m->lo[d] || P->x[d][i] > m->hi[d]) {
+                *bad = (long)i;
+                snprintf(msg, msgsize,
+                         "%s particle id %llu left the domain: %c = %g outside [%g, %g] "
+                         "(velocity %g, %g)",
+                         kind_name(P->kind[i]), (unsigned long long)P->id[i], "xyz"[d],
+                         P -> x[d][i], m -> lo[d], m -> hi[d], P -> u[0][i], P -> u[1][i]);
+                return LUB_STEP_ESCAPED;
+            }
+        }
+    }
+    return LUB_STEP_OK;
+}
+
+double lub_mps_max_speed(const lub_mps *m)
+{
+    const lub_particles *P = m->P;
+    double u2 = 0;
+#pragma omp parallel for schedule(static) reduction(max : u2)
+    for (size_t i = 0; i < P->n; i++) {
+        double s = 0;
+        for (int d = 0; d < m->dim; d++) s += P->u[d][i] * P->u[d][i];
+        if (s > u2) u2 = s;
+    }
+    return sqrt(u2);
+}
+
+lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize)
+{
+    lub_particles *P = m->P;
+    const size_t n = P->n;
+    const int dim = m->dim;
+    *bad = -1;
+    msg[0] = '\0';
+    memset(&m->st, 0, sizeof m->st);
+
+    /* 1. neighbours at r^k; cell order restored every reorder_interval steps */
+    /* the reorder schedule follows the global step, so that a restarted run sorts at the
+     * same steps as an uninterrupted one (exact restart) */
+    int rebuild = !m->built;
+    m->built = 1;
+    if (m->c.reorder_interval > 0 && m->steps % m->c.reorder_interval == 0) {
+        lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
+        reorder(m);
+        lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
+        rebuild = 1;
+    }
+    /* walls and dummies move with their patch velocity */
+    for (size_t i = 0; i < n; i++)
+        if (P->kind[i] != LUB_FLUID)
+            for (int d = 0; d < dim; d++) P->u[d][i] = m->c.patch_velocity[P->patch[i]][d];
+    neighbours(m, rebuild);
+
+    /* 2. viscosity and body force */
+    if (viscosity(m, dt, msg, msgsize)) return LUB_STEP_SOLVE_FAILED;
+
+    /* 3. temporary positions (T-8) */
+    lub_timer_start(&m->tm, LUB_T_OTHER);
+    for (int d = 0; d < dim; d++) {
+        double *x = P->x[d];
+        const double *us = m->us[d];
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++) x[i] += us[i] * dt;
+    }
+    lub_timer_stop(&m->tm, LUB_T_OTHER);
+    neighbours(m, 0);
+
+    /* 4. PND at r* (T-11), 5. free surface */
+    lub_timer_start(&m->tm, LUB_T_ASSEMBLY);
+    lub_mps_mask pm = {P->kind, K_FLUID | K_WALL, K_FLUID | K_WALL | K_DUMMY};
+    lub_mps_pnd(&m->nb, &pm, m->pnd);
+    free_surface(m);
+    lub_timer_stop(&m->tm, LUB_T_ASSEMBLY);
+
+    /* 6. pressure */
+    if (pressure(m, dt, msg, msgsize)) return LUB_STEP_SOLVE_FAILED;
+
+    /* 7. gradient, 8. correction (T-16, T-17) */
+    lub_timer_start(&m->tm, LUB_T_GRADIENT);
+    lub_mps_mask gm = {P->kind, K_FLUID, K_FLUID | K_WALL};
+    if (m->c.gradient == LUB_GRADIENT_LSMPS)
+        m->st.nfallback = lub_mps_gradient_lsmps(&m->nb, &gm, m->n0, m->c.min_pressure_shift,
+                                                 m->c.lsmps_det_min, P->p, m->grad);
+    else
+        lub_mps_gradient(&m->nb, &gm, m->n0, m->c.min_pressure_shift, P->p, m->grad);
+    const double f = dt / m->c.rho;
+    for (int d = 0; d < dim; d++) {
+        double *u = P->u[d], *x = P->x[d];
+        const double *us = m->us[d], *gr = m->grad[d];
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            if (P->kind[i] != LUB_FLUID) continue;
+            u[i] = us[i] - f * gr[i];
+            x[i] += (u[i] - us[i]) * dt;
+        }
+    }
+    lub_timer_stop(&m->tm, LUB_T_GRADIENT);
+
+    /* 9. collision, periodic wrap, checks */
+    if (m->c.collision) {
+        neighbours(m, 0);
+        lub_timer_start(&m->tm, LUB_T_OTHER);
+        collision(m, dt);
+        lub_timer_stop(&m->tm, LUB_T_OTHER);
+    }
+    lub_timer_start(&m->tm, LUB_T_OTHER);
+    wrap(m);
+    lub_step_status s = check(m, bad, msg, msgsize);
+    m->st.umax = lub_mps_max_speed(m);
+    lub_timer_stop(&m->tm, LUB_T_OTHER);
+    m->steps++;
+    return s;
+}

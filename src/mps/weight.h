@@ -1,0 +1,19 @@
+/* lubkit MPS: the weight function.
+ *
+ * Every MPS sum (PND, Laplacian, gradients, reference values n0 and lambda0) weighs a pair
+ * through this one function, so that n0 and lambda0 stay consistent with the operators.
+ */
+#ifndef LUB_MPS_WEIGHT_H
+#define LUB_MPS_WEIGHT_H
+
+/* thesis (T-6), Kondo & Koshizuka 2008: w(r) = (r/re - 1)^2 for r < re, 0 otherwise.
+ * Finite at r = 0 (w = 1) and with w' = 0 at r = re, so PND varies smoothly as particles
+ * cross the effective radius. */
+static inline double lub_mps_weight(double r, double re)
+{
+    /* 1/re is hoisted out of the callers' loops: a multiply per pair, not a division */
+    const double q = r * (1.0 / re) - 1.0;
+    return r < re ? q * q : 0.0;
+}
+
+#endif
