@@ -1,5 +1,6 @@
 /* lubkit geometry discretisation (see discretise.h for the lattice and the rules). */
 #include "geometry/discretise.h"
+#include "mps/operators.h"
 
 #include <math.h>
 #include <stdint.h>
@@ -664,22 +665,11 @@ static void region_bbox(const lub_geometry *g, const lub_region *r, double *lo, 
 
 void lub_level_reference(int dim, double l0, lub_level *lev)
 {
-    double re = 3.1 * l0, n0 = 0.0, num = 0.0;
-    int m = (int)ceil(re / l0);
-    for (int i = -m; i <= m; i++)
-        for (int j = -m; j <= m; j++)
-            for (int k = (dim == 3 ? -m : 0); k <= (dim == 3 ? m : 0); k++) {
-                if (!i && !j && !k) continue;
-                double r = l0 * sqrt((double)(i * i + j * j + k * k));
-                if (r >= re) continue;
-                double w = (r / re - 1.0) * (r / re - 1.0); /* (T-6) */
-                n0 += w;                                    /* (T-4) */
-                num += r * r * w;                           /* (T-5) */
-            }
+    /* re = 3.1 l0, the thesis' choice; lubFoam recomputes all three from the
+     * effectiveRadius of system/schemes.yaml and writes them back with its time folders */
     lev->l0 = l0;
-    lev->re = re;
-    lev->n0 = n0;
-    lev->lambda0 = num / n0;
+    lev->re = 3.1 * l0;
+    lub_mps_reference(dim, l0, lev->re, &lev->n0, &lev->lambda0); /* (T-4, T-5) */
 }
 
 double lub_geometry_estimate(const lub_geometry *g)

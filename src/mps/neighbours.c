@@ -14,9 +14,6 @@
 /* Arrays grow with this headroom so that a slowly growing pair count does not reallocate
  * every step. */
 #define HEADROOM 1.25
-/* Rows shorter than this are scanned whole; longer ones are cut to an x window by bisection
- * (see segment_window). */
-#define WINDOW_MIN 16
 
 static const char axis_name[3] = {'x', 'y', 'z'};
 
@@ -164,12 +161,6 @@ static inline int search_position(const lub_neighbours *nb, double *const x[3], 
         }
         xi[d] = v;
     }
-    /* A particle with a non-finite coordinate is put at +infinity in every direction: it
-     * keeps the cells sorted in x and is at an infinite (or NaN) distance from everyone. */
-    if (!(isfinite(xi[0]) && isfinite(xi[1]) && (nb->dim == 2 || isfinite(xi[2])))) {
-        escaped = 1;
-        for (int d = 0; d < nb->dim; d++) xi[d] = INFINITY;
-    }
     return escaped;
 }
 
@@ -182,7 +173,7 @@ size_t lub_neighbours_bin(lub_neighbours *nb, size_t n, double *const x[3])
     size_t *count = nb->cell_start;
     memset(count, 0, (nb->ncells + 1) * sizeof *count);
 
-    /* Counting sort of the particles by cell. */
+    /* Counting sort of the particles by cell, stable in the particle index. */
     size_t escaped = 0;
     for (size_t i = 0; i < n; i++) {
         double xi[3] = {0, 0, 0};
@@ -199,29 +190,9 @@ size_t lub_neighbours_bin(lub_neighbours *nb, size_t n, double *const x[3])
         double xi[3];
         search_position(nb, x, i, xi);
         nb->perm[k] = (uint32_t)i;
+        nb->spos[i] = (uint32_t)k;
         for (int d = 0; d < dim; d++) nb->xs[d][k] = xi[d];
     }
-    /* Within a cell, order by x (insertion sort, stable: nearly linear once the caller keeps
-     * its particles in cell order).  The cells of a row then hold their particles in
-     * ascending x, so the search can cut each row down to an x window. */
-    double *xs0 = nb->xs[0], *xs1 = nb->xs[1], *xs2 = nb->xs[2];
-    for (size_t c = 0; c < nb->ncells; c++) {
-        const size_t k0 = nb->cell_start[c], k1 = nb->cell_start[c + 1];
-        for (size_t k = k0 + 1; k < k1; k++) {
-            const double a0 = xs0[k];
-            if (!(a0 < xs0[k - 1])) continue;
-            const double a1 = xs1[k], a2 = dim == 3 ? xs2[k] : 0.0;
-            const uint32_t pk = nb->perm[k];
-            size_t q = k;
-            for (; q > k0 && a0 < xs0[q - 1]; q--) {
-                xs0[q] = xs0[q - 1], xs1[q] = xs1[q - 1], nb->perm[q] = nb->perm[q - 1];
-                if (dim == 3) xs2[q] = xs2[q - 1];
-            }
-            xs0[q] = a0, xs1[q] = a1, nb->perm[q] = pk;
-            if (dim == 3) xs2[q] = a2;
-        }
-    }
-    for (size_t k = 0; k < n; k++) nb->spos[nb->perm[k]] = (uint32_t)k;
     nb->nescaped = escaped;
     return escaped;
 }
@@ -231,24 +202,7 @@ size_t lub_neighbours_bin(lub_neighbours *nb, size_t n, double *const x[3])
 typedef struct {
     size_t k0, k1;
     double s[3];
-    /* extent of the row in y and z, shifted; infinite on the outer side of a boundary cell
-     * of a non-periodic direction, which also holds the particles clamped into it */
-    double ylo, yhi, zlo, zhi;
 } segment;
-
-/* Extent [elo, ehi] of cell row c in direction d, shifted by s (see segment). */
-static inline void row_extent(const lub_neighbours *nb, int d, int c, double s, double *elo,
-                              double *ehi)
-{
-    if (d >= nb->dim) {
-        *elo = -INFINITY, *ehi = INFINITY;
-        return;
-    }
-    *elo = nb->lo[d] + c * nb->h[d] + s;
-    *ehi = nb->lo[d] + (c + 1) * nb->h[d] + s;
-    if (!nb->periodic[d] && c == 0) *elo = -INFINITY;
-    if (!nb->periodic[d] && c == nb->nc[d] - 1) *ehi = INFINITY;
-}
 
 /* Neighbour cell coordinate c in direction d: wrapped with its shift, or 0 if outside. */
 static inline int neighbour_coord(const lub_neighbours *nb, int d, int *c, double *s)
@@ -277,16 +231,12 @@ static int cell_segments(const lub_neighbours *nb, size_t c, segment *seg)
     int ns = 0;
     for (int dz = -oz; dz <= oz; dz++) {
         int z = cz + dz;
-        double sz, zlo, zhi;
+        double sz;
         if (!neighbour_coord(nb, 2, &z, &sz)) continue;
-        row_extent(nb, 2, z, sz, &zlo, &zhi);
         for (int dy = -1; dy <= 1; dy++) {
             int y = cy + dy;
-            double sy, ylo, yhi;
+            double sy;
             if (!neighbour_coord(nb, 1, &y, &sy)) continue;
-            row_extent(nb, 1, y, sy, &ylo, &yhi);
-            /* segments of one row only merge with each other: they stay sorted in x */
-            const int row_first = ns;
             for (int dx = -1; dx <= 1; dx++) {
                 int x = cx + dx;
                 double sx;
@@ -294,12 +244,12 @@ static int cell_segments(const lub_neighbours *nb, size_t c, segment *seg)
                 size_t cell = (size_t)x + (size_t)nx * ((size_t)y + (size_t)ny * (size_t)z);
                 size_t k0 = nb->cell_start[cell], k1 = nb->cell_start[cell + 1];
                 if (k0 == k1) continue;
-                if (ns > row_first && seg[ns - 1].k1 == k0 && seg[ns - 1].s[0] == sx) {
+                if (ns > 0 && seg[ns - 1].k1 == k0 && seg[ns - 1].s[0] == sx &&
+                    seg[ns - 1].s[1] == sy && seg[ns - 1].s[2] == sz) {
                     seg[ns - 1].k1 = k1;
                 } else {
                     seg[ns].k0 = k0, seg[ns].k1 = k1;
                     seg[ns].s[0] = sx, seg[ns].s[1] = sy, seg[ns].s[2] = sz;
-                    seg[ns].ylo = ylo, seg[ns].yhi = yhi, seg[ns].zlo = zlo, seg[ns].zhi = zhi;
                     ns++;
                 }
             }
@@ -319,63 +269,6 @@ static inline double dist2(int dim, const double *const xs[3], size_t k, const d
     return r2;
 }
 
-/* First k in [k0, k1) with v[k] >= key (v ascending there); branch-free halving. */
-static inline size_t lower_bound(const double *v, size_t k0, size_t k1, double key)
-{
-    const double *base = v + k0;
-    size_t len = k1 - k0;
-    if (len == 0) return k0;
-    while (len > 1) {
-        const size_t half = len / 2;
-        base = base[half] < key ? base + half : base;
-        len -= half;
-    }
-    return (size_t)(base - v) + (base[0] < key);
-}
-
-/* The candidates of segment sg for a particle at xi: the whole segment when it is short,
- * else the x window |x_k + s_x - x_i| < sqrt(rs^2 - g^2), g the distance from xi to the row
- * in y and z (a pair in that row has |r_ij| >= g).  The window is widened by a relative
- * 1e-9 against round-off; the distance test decides.  The window bounds are the first
- * positions with x >= the window's ends (unique, as the segment is sorted in x), found by
- * moving the bounds st of the previous particle of the same cell (a few steps when the
- * particles are in cell order) or by bisection when st[0] is unset (SIZE_MAX). */
-static inline void segment_window(const lub_neighbours *nb, const segment *sg, const double xi[3],
-                                  double rs2, size_t st[2], size_t *ka, size_t *kb)
-{
-    const size_t k0 = sg->k0, k1 = sg->k1;
-    *ka = k0, *kb = k1;
-    if (k1 - k0 < WINDOW_MIN) return;
-    /* distance to the row, shrunk by 1e-9 of a cell (plain comparisons: fmax is a call) */
-    const double ty = 1e-9 * nb->h[1], tz = 1e-9 * nb->h[2];
-    double gy = sg->ylo - xi[1] > xi[1] - sg->yhi ? sg->ylo - xi[1] : xi[1] - sg->yhi;
-    double gz = sg->zlo - xi[2] > xi[2] - sg->zhi ? sg->zlo - xi[2] : xi[2] - sg->zhi;
-    gy = gy > ty ? gy - ty : 0.0, gz = gz > tz ? gz - tz : 0.0;
-    const double g2 = gy * gy + gz * gz;
-    if (!(g2 < rs2)) {
-        /* the row is out of reach (or xi is at infinity): no candidates */
-        *kb = *ka;
-        return;
-    }
-    const double a = sqrt(rs2 - g2) * (1.0 + 1e-9) + 1e-9 * nb->rs;
-    const double c = xi[0] - sg->s[0], lo = c - a, hi = c + a;
-    const double *v = nb->xs[0];
-    size_t p, q;
-    if (st[0] == SIZE_MAX) {
-        p = lower_bound(v, k0, k1, lo);
-        q = lower_bound(v, p, k1, hi);
-    } else {
-        p = st[0];
-        while (p > k0 && v[p - 1] >= lo) p--;
-        while (p < k1 && v[p] < lo) p++;
-        q = st[1] > p ? st[1] : p;
-        while (q > p && v[q - 1] >= hi) q--;
-        while (q < k1 && v[q] < hi) q++;
-    }
-    st[0] = p, st[1] = q;
-    *ka = p, *kb = q;
-}
-
 /* Count the pairs of every particle into start[i + 1].  The particle itself is among the
  * candidates once (own cell, no shift) at distance 0 when its position is finite. */
 static void count_sweep(lub_neighbours *nb)
@@ -387,24 +280,18 @@ static void count_sweep(lub_neighbours *nb)
 #pragma omp parallel
     {
         segment seg[27];
-        size_t st[27][2];
         int ns = 0;
         size_t last_cell = (size_t)-1;
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
             const size_t c = nb->cell[i], ki = nb->spos[i];
-            if (c != last_cell) {
-                ns = cell_segments(nb, c, seg), last_cell = c;
-                for (int q = 0; q < ns; q++) st[q][0] = SIZE_MAX;
-            }
+            if (c != last_cell) ns = cell_segments(nb, c, seg), last_cell = c;
             const double xi[3] = {xs[0][ki], xs[1][ki], dim == 3 ? xs[2][ki] : 0.0};
             size_t m = 0;
             for (int s = 0; s < ns; s++) {
                 const double p[3] = {seg[s].s[0] - xi[0], seg[s].s[1] - xi[1], seg[s].s[2] - xi[2]};
-                size_t ka, kb;
-                segment_window(nb, &seg[s], xi, rs2, st[s], &ka, &kb);
 #pragma omp simd reduction(+ : m)
-                for (size_t k = ka; k < kb; k++) {
+                for (size_t k = seg[s].k0; k < seg[s].k1; k++) {
                     double d[3];
                     m += dist2(dim, xs, k, p, d) < rs2;
                 }
@@ -435,25 +322,19 @@ static void fill_sweep(lub_neighbours *nb)
 #pragma omp parallel reduction(| : mismatch)
     {
         segment seg[27];
-        size_t st[27][2];
         int ns = 0;
         size_t last_cell = (size_t)-1;
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
             const size_t c = nb->cell[i], ki = nb->spos[i];
-            if (c != last_cell) {
-                ns = cell_segments(nb, c, seg), last_cell = c;
-                for (int q = 0; q < ns; q++) st[q][0] = SIZE_MAX;
-            }
+            if (c != last_cell) ns = cell_segments(nb, c, seg), last_cell = c;
             const double xi[3] = {xs[0][ki], xs[1][ki], dim == 3 ? xs[2][ki] : 0.0};
             const size_t end = nb->start[i + 1];
             size_t m = nb->start[i];
             for (int s = 0; s < ns; s++) {
                 const double p[3] = {seg[s].s[0] - xi[0], seg[s].s[1] - xi[1], seg[s].s[2] - xi[2]};
                 const size_t ms = m;
-                size_t ka, kb;
-                segment_window(nb, &seg[s], xi, rs2, st[s], &ka, &kb);
-                for (size_t k = ka; k < kb; k++) {
+                for (size_t k = seg[s].k0; k < seg[s].k1; k++) {
                     double d[3];
                     const double r2 = dist2(dim, xs, k, p, d);
                     if (m < end) J[m] = (uint32_t)k;

@@ -127,6 +127,23 @@ static void neighbours(lub_mps *m, int rebuild)
     lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
 }
 
+/* Pass 1 of the CSR assembly of an MPS matrix over the unknowns prow[0..nrows): row r has
+ * the diagonal and one entry per neighbour j with w_ij > 0 that is itself an unknown. */
+static void begin_rows(lub_mps *m, int nrows)
+{
+    const lub_neighbours *nb = &m->nb;
+    lub_csr_begin(&m->A, nrows);
+#pragma omp parallel for schedule(static)
+    for (int r = 0; r < nrows; r++) {
+        size_t i = (size_t)m->prow[r];
+        int len = 1;
+        for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++)
+            if (nb->w[q] > 0 && m->row[nb->j[q]] >= 0) len++;
+        lub_csr_set_row_length(&m->A, r, len);
+    }
+    lub_csr_alloc(&m->A);
+}
+
 /* Viscosity and body force -> u* (T-7 explicit, T-31 Crank-Nicolson).  Wall and dummy
  * particles keep their prescribed velocity and act as Dirichlet values.
  *
@@ -172,16 +189,7 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
             m->row[i] = P->kind[i] == LUB_FLUID ? nf : -1;
             if (P->kind[i] == LUB_FLUID) m->prow[nf++] = (int)i;
         }
-        lub_csr_begin(&m->A, nf);
-#pragma omp parallel for schedule(static)
-        for (int r = 0; r < nf; r++) {
-            size_t i = (size_t)m->prow[r];
-            int len = 1;
-            for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++)
-                if (nb->w[q] > 0 && m->row[nb->j[q]] >= 0) len++;
-            lub_csr_set_row_length(&m->A, r, len);
-        }
-        lub_csr_alloc(&m->A);
+        begin_rows(m, nf);
 #pragma omp parallel for schedule(static)
         for (int r = 0; r < nf; r++) {
             size_t i = (size_t)m->prow[r];
@@ -303,16 +311,7 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
                  "for a closed domain");
         return -1;
     }
-    lub_csr_begin(&m->A, nu);
-#pragma omp parallel for schedule(static)
-    for (int r = 0; r < nu; r++) {
-        size_t i = (size_t)m->prow[r];
-        int len = 1;
-        for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++)
-            if (nb->w[q] > 0 && m->row[nb->j[q]] >= 0) len++;
-        lub_csr_set_row_length(&m->A, r, len);
-    }
-    lub_csr_alloc(&m->A);
+    begin_rows(m, nu);
 #pragma omp parallel for schedule(static)
     for (int r = 0; r < nu; r++) {
         size_t i = (size_t)m->prow[r];
