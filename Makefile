@@ -52,6 +52,9 @@ BINS      := $(PROGRAMS:%=$(BUILD)/bin/%)
 TEST_SRC  := $(sort $(wildcard tests/unit/*_test.c))
 TEST_BINS := $(TEST_SRC:tests/unit/%.c=$(BUILD)/tests/%)
 
+BENCH_SRC  := $(sort $(wildcard tests/bench/*_bench.c))
+BENCH_BINS := $(BENCH_SRC:tests/bench/%.c=$(BUILD)/bench/%)
+
 .PHONY: all test demo bench install clean deps format tests
 .SECONDARY:
 all: $(LIB) $(BINS)
@@ -79,6 +82,10 @@ $(BUILD)/tests/%_test: $(BUILD)/obj/tests/unit/%_test.o $(LIB)
 
 tests: all $(TEST_BINS)
 
+$(BUILD)/bench/%_bench: $(BUILD)/obj/tests/bench/%_bench.o $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
 # deps: install missing Debian packages only when pkg-config or the CHOLMOD header is missing.
 deps:
 	@pkg-config --exists $(PKGS) 2>/dev/null && [ -n "$(CHOLMOD_INC)" ] \
@@ -94,7 +101,7 @@ demo: deps
 	@LUB_BUILD=$(BUILD) bin/lubDemo
 
 bench: deps
-	@$(MAKE) --no-print-directory all
+	@$(MAKE) --no-print-directory all $(BENCH_BINS)
 	@LUB_BUILD=$(BUILD) tests/bench/run
 
 install: all
