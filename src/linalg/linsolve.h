@@ -3,7 +3,7 @@
  *
  *     p:                          # pressure Poisson equation (T-9)
  *       solver: pcg               # lub_linsolver_choice_names: cholmod | pcg
- *       preconditioner: ic0       # none | jacobi | ic0 | sgs | bic0 (lub_precond_choice_names)
+ *       preconditioner: amg       # none | jacobi | ic0 | sgs | bic0 | amg
  *       tolerance: 1e-8           # relative residual ||b - A x|| / ||b|| (pcg)
  *       maxIter: 1000             # (pcg)
  *       warmStart: true           # start from the previous solution (pcg)

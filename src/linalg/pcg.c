@@ -16,7 +16,8 @@
 
 #include "core/error.h"
 
-const char *const lub_precond_choice_names[] = {"none", "jacobi", "ic0", "sgs", "bic0", NULL};
+const char *const lub_precond_choice_names[] = {"none", "jacobi", "ic0", "sgs",
+                                                "bic0", "amg",    NULL};
 
 lub_pcg_options lub_pcg_defaults(void)
 {
@@ -27,6 +28,7 @@ lub_pcg_options lub_pcg_defaults(void)
 void lub_pcg_work_init(lub_pcg_work *w)
 {
     memset(w, 0, sizeof *w);
+    lub_amg_init(&w->amg);
 }
 
 void lub_pcg_work_free(lub_pcg_work *w)
@@ -41,6 +43,7 @@ void lub_pcg_work_free(lub_pcg_work *w)
     free(w->l_val);
     free(w->mark);
     free(w->l_first);
+    lub_amg_free(&w->amg);
     lub_pcg_work_init(w);
 }
 
@@ -261,6 +264,13 @@ double lub_pcg_setup(lub_pcg_work *w, const lub_csr *A, const lub_pcg_options *o
         w->ic_shift = shift;
         break;
     }
+    case LUB_PRECOND_AMG:
+        if (lub_amg_setup(&w->amg, A) != 0) {
+            w->precond_used = LUB_PRECOND_JACOBI;
+            setup_diag(w, A);
+            w->ic_shift = -1.0;
+        }
+        break;
     default:
         lub_bug("unknown preconditioner %d", (int)o->precond);
     }
@@ -270,7 +280,7 @@ double lub_pcg_setup(lub_pcg_work *w, const lub_csr *A, const lub_pcg_options *o
     return w->ic_shift;
 }
 
-void lub_pcg_precond_apply(const lub_pcg_work *w, const lub_csr *A, const double *r, double *z)
+void lub_pcg_precond_apply(lub_pcg_work *w, const lub_csr *A, const double *r, double *z)
 {
     const int n = A->n;
     switch (w->precond_used) {
@@ -289,6 +299,9 @@ void lub_pcg_precond_apply(const lub_pcg_work *w, const lub_csr *A, const double
         break;
     case LUB_PRECOND_SGS:
         sgs_apply(w, A, w->omega, r, z);
+        break;
+    case LUB_PRECOND_AMG:
+        lub_amg_apply(&w->amg, r, z);
         break;
     }
 }
@@ -352,7 +365,7 @@ static double update_xr(int n, double alpha, const double *p, const double *q, d
 }
 
 /* z = M^-1 r, returns r.z (Jacobi fused into one pass) */
-static double precond_dot(const lub_pcg_work *w, const lub_csr *A, const double *r, double *z)
+static double precond_dot(lub_pcg_work *w, const lub_csr *A, const double *r, double *z)
 {
     const int n = A->n;
     if (w->precond_used == LUB_PRECOND_JACOBI) {

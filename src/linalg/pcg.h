@@ -23,23 +23,31 @@
  * Preconditioners (the index is the position in lub_precond_choice_names):
  *   none    M = I
  *   jacobi  M = diag(A); fully parallel (OpenMP), fused with the vector updates
- *   ic0     incomplete Cholesky with zero fill, L on the lower pattern of A; its two
- *           triangular solves are sequential.  If a pivot is not positive (possible for an
- *           SPD matrix that is not an M-matrix) the factorisation is repeated for
- *           A + s diag(A) with s = 1e-3, 1e-2, ... (Manteuffel's shift); the shift used is
- *           reported in lub_solve_result.ic_shift; if even s = 100 fails, Jacobi is used and
- *           ic_shift = -1.
- *   bic0    block IC(0): the rows are split into contiguous blocks balanced by nonzeros,
- *           one per OpenMP thread unless options.blocks says otherwise, and the couplings between
- * blocks are dropped from the factor, so the factorisation and both sweeps run in parallel; a few
- * more iterations than ic0 (2 blocks cut the lattice once).  With 1 thread it is ic0. The iteration
- * count depends on the number of blocks. sgs     symmetric Gauss-Seidel / SSOR with relaxation
- * omega (default 1) straight on the rows of A (no set-up beyond 1/a_ii); sequential sweeps. With
- * OpenMP (OMP_NUM_THREADS) SpMV, dot products and vector updates are parallel.
+ *   ic0     incomplete Cholesky with zero fill, L on the lower pattern of A (stored in
+ *           single precision); its two triangular solves are sequential.  If a pivot is
+ *           not positive (possible for an SPD matrix that is not an M-matrix) the
+ *           factorisation is repeated for A + s diag(A) with s = 1e-3, 1e-2, ...
+ *           (Manteuffel's shift); the shift used is reported in lub_solve_result.ic_shift;
+ *           if even s = 100 fails, Jacobi is used and ic_shift = -1.
+ *   sgs     symmetric Gauss-Seidel / SSOR with relaxation omega (default 1) straight on the
+ *           rows of A (no set-up beyond 1/a_ii); sequential sweeps.
+ *   bic0    block IC(0): the rows are split into contiguous blocks balanced by nonzeros, one
+ *           per OpenMP thread unless options.blocks says otherwise, and the couplings
+ *           between blocks are dropped from the factor, so the factorisation and both
+ *           sweeps run in parallel; more iterations than ic0 (2 blocks: +20% on the 80k
+ *           MPS-like matrix).  With 1 block it is ic0.
+ *   amg     one V-cycle of aggregation algebraic multigrid (amg.h): an iteration count that
+ *           hardly grows with the particle count, block-parallel smoothing.  The fastest
+ *           here: 80k MPS-like unknowns to 1e-8 in 19 iterations, about 6 times faster than
+ *           ic0 on 2 threads (tests/bench/linalg_bench.c).  If its coarsest matrix is not
+ *           positive definite, Jacobi is used and ic_shift = -1.
+ * bic0 and amg iterate differently with a different number of threads (blocks).
+ * With OpenMP (OMP_NUM_THREADS) SpMV, dot products and vector updates are parallel.
  */
 #ifndef LUB_LINALG_PCG_H
 #define LUB_LINALG_PCG_H
 
+#include "linalg/amg.h"
 #include "linalg/csr.h"
 #include "linalg/solve_result.h"
 
@@ -48,7 +56,8 @@ typedef enum {
     LUB_PRECOND_JACOBI = 1,
     LUB_PRECOND_IC0 = 2,
     LUB_PRECOND_SGS = 3,
-    LUB_PRECOND_BIC0 = 4
+    LUB_PRECOND_BIC0 = 4,
+    LUB_PRECOND_AMG = 5
 } lub_precond;
 
 /* Most blocks of the block IC(0) (one per OpenMP thread). */
@@ -80,6 +89,7 @@ typedef struct lub_pcg_work {
     float *l_val; /* single precision: the sweeps are bandwidth-bound, and a rounded L
                      is still an exact factor of an SPD M = L L^T */
     int *mark;    /* n, -1 outside the IC(0) factorisation of a row */
+    lub_amg amg;  /* amg */
     /* what the preconditioner was built for */
     const lub_csr *A;
     unsigned long stamp;
@@ -104,6 +114,6 @@ void lub_pcg_solve(lub_pcg_work *w, const lub_csr *A, const double *b, double *x
                    const lub_pcg_options *o, lub_solve_result *res);
 
 /* Apply the preconditioner set up in w: z = M^-1 r (exposed for tests). */
-void lub_pcg_precond_apply(const lub_pcg_work *w, const lub_csr *A, const double *r, double *z);
+void lub_pcg_precond_apply(lub_pcg_work *w, const lub_csr *A, const double *r, double *z);
 
 #endif

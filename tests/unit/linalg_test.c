@@ -566,6 +566,165 @@ static void test_ic0_shift_on_breakdown(void)
     lub_csr_free(&A);
 }
 
+/* The AMG V-cycle (here with the 2-block hybrid smoother) must be a symmetric positive
+ * definite operator for CG: u.M^-1 v =
+ * v.M^-1 u (to round-off) and u.M^-1 u > 0 for random u, v; with a single level (n <=
+ * coarse_max, dense Cholesky) it is A^-1 and PCG converges in one iteration; on the 2-D
+ * Poisson matrix (3 levels) it needs fewer iterations than IC(0). */
+static void test_amg_preconditioner(void)
+{
+    int m = 80, n = m * m;
+    lub_csr A;
+    lub_csr_init(&A);
+    poisson2d(&A, m);
+    lub_pcg_work w;
+    lub_pcg_work_init(&w);
+    w.amg.blocks = 2; /* the hybrid (block) Gauss-Seidel smoother, whatever the threads */
+    lub_pcg_options o = lub_pcg_defaults();
+    o.precond = LUB_PRECOND_AMG;
+    lub_pcg_setup(&w, &A, &o);
+    CHECK(w.amg.nblocks == 2);
+    CHECK(w.amg.nlev >= 3);
+    CHECK(w.amg.lev[1].A->n < n / 3);
+    CHECK(lub_csr_asymmetry(w.amg.lev[1].A) < 1e-15);
+    double *u = malloc(n * sizeof *u), *v = malloc(n * sizeof *v), *mu = malloc(n * sizeof *mu),
+           *mv = malloc(n * sizeof *mv);
+    for (int t = 0; t < 3; t++) {
+        for (int i = 0; i < n; i++) u[i] = rnd() - 0.5, v[i] = rnd() - 0.5;
+        lub_pcg_precond_apply(&w, &A, u, mu);
+        lub_pcg_precond_apply(&w, &A, v, mv);
+        double umv = 0, vmu = 0, umu = 0, scale = 0;
+        for (int i = 0; i < n; i++) {
+            umv += u[i] * mv[i];
+            vmu += v[i] * mu[i];
+            umu += u[i] * mu[i];
+            scale += fabs(u[i] * mv[i]);
+        }
+        CHECK_NEAR(umv, vmu, 1e-13 * scale);
+        CHECK(umu > 0);
+    }
+    int amg = iterations_2d(m, LUB_PRECOND_AMG, 1e-8);
+    int ic0 = iterations_2d(m, LUB_PRECOND_IC0, 1e-8);
+    CHECK(amg < ic0);
+    printf("  2-D Poisson 80x80: amg %d iterations (%d levels), ic0 %d\n", amg, w.amg.nlev, ic0);
+    /* one level: exact */
+    CHECK(iterations_2d(15, LUB_PRECOND_AMG, 1e-12) == 1);
+    /* no off-diagonal couplings, n > coarse_max: nothing to aggregate, the single level is
+     * smoothed by Gauss-Seidel, which is exact for a diagonal matrix */
+    int nd = 1000;
+    lub_csr_begin(&A, nd);
+    for (int i = 0; i < nd; i++) lub_csr_set_row_length(&A, i, 1);
+    lub_csr_alloc(&A);
+    for (int i = 0; i < nd; i++) *lub_csr_row_col(&A, i) = i, *lub_csr_row_val(&A, i) = 1.0 + i;
+    lub_csr_finish(&A);
+    for (int i = 0; i < nd; i++) u[i] = 1.0;
+    lub_solve_result r;
+    lub_pcg_solve(&w, &A, u, v, &o, &r);
+    CHECK(w.amg.nlev == 1 && w.amg.coarse_gs == 1);
+    CHECK(r.converged && r.iterations == 1);
+    CHECK_NEAR(v[nd - 1], 1.0 / nd, 1e-15);
+    lub_pcg_work_free(&w);
+    lub_csr_free(&A);
+    free(u);
+    free(v);
+    free(mu);
+    free(mv);
+}
+
+/* The MPS-like pressure matrix of tests/bench/linalg_bench.c, small: particles on an
+ * nx x ny lattice (l0 = 1), neighbours within re = 3.1, w = (r/re - 1)^2, A_ij = -w_ij,
+ * A_ii = sum of w over all neighbours including Dirichlet (p = 0) ghosts above the free
+ * surface at the top; walls elsewhere have no neighbours outside. */
+static void mps_lattice(lub_csr *A, int nx, int ny)
+{
+    const double re = 3.1;
+    int n = nx * ny;
+    lub_csr_begin(A, n);
+    for (int i = 0; i < n; i++) {
+        int ix = i % nx, iy = i / nx, len = 1;
+        for (int dy = -3; dy <= 3; dy++)
+            for (int dx = -3; dx <= 3; dx++)
+                if ((dx || dy) && dx * dx + dy * dy <= re * re && ix + dx >= 0 && ix + dx < nx &&
+                    iy + dy >= 0 && iy + dy < ny)
+                    len++;
+        lub_csr_set_row_length(A, i, len);
+    }
+    lub_csr_alloc(A);
+    for (int i = 0; i < n; i++) {
+        int ix = i % nx, iy = i / nx, len = 1;
+        int *c = lub_csr_row_col(A, i);
+        double *v = lub_csr_row_val(A, i);
+        double d = 0;
+        for (int dy = -3; dy <= 3; dy++)
+            for (int dx = -3; dx <= 3; dx++) {
+                double r = sqrt((double)(dx * dx + dy * dy));
+                if (!(dx || dy) || r > re) continue;
+                double w = (r / re - 1) * (r / re - 1);
+                int jx = ix + dx, jy = iy + dy;
+                if (jx >= 0 && jx < nx && jy >= 0 && jy < ny) {
+                    c[len] = jy * nx + jx;
+                    v[len++] = -w;
+                    d += w;
+                } else if (jy >= ny && jx >= 0 && jx < nx) {
+                    d += w;
+                }
+            }
+        c[0] = i;
+        v[0] = d;
+    }
+    lub_csr_finish(A);
+}
+
+/* On the MPS-like matrix every preconditioner and CHOLMOD give the same solution (CHOLMOD's,
+ * backward stable, as the reference: both within kappa * residual of the truth), and the
+ * iteration counts are ordered amg < ic0 < jacobi. */
+static void test_mps_like_matrix_all_solvers(void)
+{
+    int nx = 60, ny = 30, n = nx * ny;
+    lub_csr A;
+    lub_csr_init(&A);
+    mps_lattice(&A, nx, ny);
+    CHECK(lub_csr_asymmetry(&A) == 0.0);
+    double *b = malloc(n * sizeof *b), *xd = malloc(n * sizeof *xd), *x = malloc(n * sizeof *x);
+    for (int i = 0; i < n; i++) b[i] = rnd() - 0.5;
+    lub_cholmod_options co = lub_cholmod_defaults();
+    lub_cholmod *ch = lub_cholmod_new(&co);
+    lub_solve_result r;
+    CHECK(lub_cholmod_factorize(ch, &A, LUB_PATTERN_COMPARE, &r) == LUB_SOLVE_OK);
+    const double *bb[1] = {b};
+    double *xx[1] = {xd};
+    CHECK(lub_cholmod_solve(ch, &A, 1, bb, xx, &r) == LUB_SOLVE_OK);
+    CHECK(r.residual < 1e-13);
+    lub_cholmod_free(ch);
+    int its[6] = {0};
+    lub_pcg_work w;
+    lub_pcg_work_init(&w);
+    for (int pc = 0; lub_precond_choice_names[pc]; pc++) {
+        lub_pcg_options o = lub_pcg_defaults();
+        o.precond = pc;
+        o.tolerance = 1e-10;
+        o.max_iter = 5000;
+        lub_pcg_solve(&w, &A, b, x, &o, &r);
+        CHECK(r.converged && r.residual <= 1e-10);
+        its[pc] = r.iterations;
+        /* kappa of this matrix: lambda_max <= 2 max a_ii = 2 sum w = 8.3 (Gershgorin);
+         * lambda_min ~ c (pi / (2 H))^2 = 0.0062 for the Laplacian with one Dirichlet side
+         * at H = ny + 1 = 31, c = sum w r^2 / (2 d) = 2.4 the stencil's diffusion
+         * coefficient: kappa ~ 1.4e3, bounded here by 1e4.  Both solutions are within
+         * kappa times their residual (1e-10 and 1e-13) of the truth. */
+        CHECK(rel_err(n, x, xd) <= 1e4 * (1e-10 + 1e-13));
+    }
+    CHECK(its[LUB_PRECOND_AMG] < its[LUB_PRECOND_IC0]);
+    CHECK(its[LUB_PRECOND_IC0] < its[LUB_PRECOND_JACOBI]);
+    printf("  MPS-like 60x30, tol 1e-10: iterations jacobi %d, ic0 %d, sgs %d, bic0 %d, amg %d\n",
+           its[1], its[2], its[3], its[4], its[5]);
+    lub_pcg_work_free(&w);
+    lub_csr_free(&A);
+    free(b);
+    free(xd);
+    free(x);
+}
+
 /* One work struct across matrices of changing size (the particle count changes from step to
  * step): the arrays grow when needed and every solve is still right. */
 static void test_pcg_work_reuse_across_sizes(void)
@@ -739,7 +898,8 @@ static void test_linsolver_names(void)
     CHECK(strcmp(lub_precond_choice_names[LUB_PRECOND_IC0], "ic0") == 0);
     CHECK(strcmp(lub_precond_choice_names[LUB_PRECOND_SGS], "sgs") == 0);
     CHECK(strcmp(lub_precond_choice_names[LUB_PRECOND_BIC0], "bic0") == 0);
-    CHECK(lub_precond_choice_names[5] == NULL);
+    CHECK(strcmp(lub_precond_choice_names[LUB_PRECOND_AMG], "amg") == 0);
+    CHECK(lub_precond_choice_names[6] == NULL);
     lub_linsolver_options o = lub_linsolver_defaults();
     o.pcg.precond = LUB_PRECOND_IC0;
     o.pcg.warm_start = 1;
@@ -811,7 +971,9 @@ int main(void)
     RUN(test_pcg_not_converged_reports_residual);
     RUN(test_pcg_special_cases);
     RUN(test_ic0_shift_on_breakdown);
+    RUN(test_amg_preconditioner);
     RUN(test_pcg_work_reuse_across_sizes);
+    RUN(test_mps_like_matrix_all_solvers);
     RUN(test_cholmod_poisson);
     RUN(test_cholmod_indefinite_fails_with_column);
     RUN(test_cholmod_reanalyse_on_pattern_change);

@@ -1,0 +1,300 @@
+/* lubkit linalg: aggregation AMG preconditioner (see amg.h). */
+#include "linalg/amg.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+
+void lub_amg_init(lub_amg *g)
+{
+    memset(g, 0, sizeof *g);
+    g->theta = 0.5;
+    g->alpha = 1.8;
+    g->coarse_max = 400;
+    for (int l = 0; l < LUB_AMG_MAX_LEVELS; l++) lub_csr_init(&g->lev[l].own);
+}
+
+void lub_amg_free(lub_amg *g)
+{
+    for (int l = 0; l < LUB_AMG_MAX_LEVELS; l++) {
+        lub_csr_free(&g->lev[l].own);
+        free(g->lev[l].agg);
+        free(g->lev[l].b);
+        free(g->lev[l].x);
+        free(g->lev[l].tmp);
+    }
+    free(g->dense);
+    free(g->cnt);
+    free(g->rows);
+    free(g->mark);
+    memset(g, 0, sizeof *g);
+}
+
+static void grow_int(int **p, int *cap, int n)
+{
+    if (n <= *cap && *p) return;
+    *cap = n + n / 8 + 16;
+    *p = lub_realloc(*p, (size_t)*cap * sizeof **p);
+}
+
+/* Greedy aggregation on the strong connections; returns the number of aggregates. */
+static int aggregate(const lub_csr *A, double theta, int *agg)
+{
+    const int n = A->n;
+    int nc = 0;
+    for (int i = 0; i < n; i++) agg[i] = -1;
+    /* pass 1: a node with all strong neighbours free starts an aggregate with them */
+    for (int i = 0; i < n; i++) {
+        if (agg[i] >= 0) continue;
+        double mx = 0;
+        for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1]; k++)
+            if (A->col[k] != i && -A->val[k] > mx) mx = -A->val[k];
+        const double cut = theta * mx;
+        int free_all = 1;
+        for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1] && free_all; k++) {
+            int j = A->col[k];
+            if (j != i && -A->val[k] > 0 && -A->val[k] >= cut && agg[j] >= 0) free_all = 0;
+        }
+        if (!free_all) continue;
+        agg[i] = nc;
+        for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1]; k++) {
+            int j = A->col[k];
+            if (j != i && -A->val[k] > 0 && -A->val[k] >= cut) agg[j] = nc;
+        }
+        nc++;
+    }
+    /* pass 2: the rest join the aggregate of their strongest aggregated neighbour */
+    for (int i = 0; i < n; i++) {
+        if (agg[i] >= 0) continue;
+        double best = 0;
+        int bj = -1;
+        for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1]; k++) {
+            int j = A->col[k];
+            if (j != i && agg[j] >= 0 && -A->val[k] > best) best = -A->val[k], bj = j;
+        }
+        agg[i] = bj >= 0 ? agg[bj] : nc++;
+    }
+    return nc;
+}
+
+/* C = P^T A P for the piecewise-constant P of agg: C_IJ = sum_{i in I, j in J} a_ij. */
+static void galerkin(lub_amg *g, const lub_csr *A, const int *agg, int nc, lub_csr *C)
+{
+    const int n = A->n;
+    grow_int(&g->cnt, &g->cnt_cap, nc + 1);
+    grow_int(&g->rows, &g->rows_cap, n);
+    grow_int(&g->mark, &g->mark_cap, 2 * nc);
+    int *cnt = g->cnt, *rows = g->rows, *mark = g->mark, *pos = g->mark + nc;
+    /* the fine rows of each aggregate, in CSR form */
+    memset(cnt, 0, (size_t)(nc + 1) * sizeof *cnt);
+    for (int i = 0; i < n; i++) cnt[agg[i] + 1]++;
+    for (int I = 0; I < nc; I++) cnt[I + 1] += cnt[I];
+    memcpy(pos, cnt, (size_t)nc * sizeof *pos);
+    for (int i = 0; i < n; i++) rows[pos[agg[i]]++] = i;
+    /* pass 1: row lengths (distinct coarse columns) */
+    for (int I = 0; I < nc; I++) mark[I] = -1;
+    lub_csr_begin(C, nc);
+    for (int I = 0; I < nc; I++) {
+        int len = 0;
+        for (int t = cnt[I]; t < cnt[I + 1]; t++) {
+            int i = rows[t];
+            for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1]; k++) {
+                int J = agg[A->col[k]];
+                if (mark[J] != I) mark[J] = I, len++;
+            }
+        }
+        lub_csr_set_row_length(C, I, len);
+    }
+    lub_csr_alloc(C);
+    /* pass 2: sums; mark[J] = position of J in the current coarse row */
+    for (int I = 0; I < nc; I++) mark[I] = -1;
+    for (int I = 0; I < nc; I++) {
+        int *c = lub_csr_row_col(C, I);
+        double *v = lub_csr_row_val(C, I);
+        int len = 0;
+        for (int t = cnt[I]; t < cnt[I + 1]; t++) {
+            int i = rows[t];
+            for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1]; k++) {
+                int J = agg[A->col[k]];
+                if (mark[J] < 0) {
+                    mark[J] = len;
+                    c[len] = J;
+                    v[len++] = 0.0;
+                }
+                v[mark[J]] += A->val[k];
+            }
+        }
+        for (int q = 0; q < len; q++) mark[c[q]] = -1;
+    }
+    lub_csr_finish(C);
+}
+
+/* Dense Cholesky of the coarsest matrix (lower triangle, row-major); -1 if not SPD. */
+static int coarse_factor(lub_amg *g, const lub_csr *A)
+{
+    const int n = A->n;
+    size_t need = (size_t)n * (size_t)n;
+    if (need > g->dense_cap || !g->dense) {
+        g->dense = lub_realloc(g->dense, (need ? need : 1) * sizeof *g->dense);
+        g->dense_cap = need;
+    }
+    double *D = g->dense;
+    memset(D, 0, need * sizeof *D);
+    for (int i = 0; i < n; i++)
+        for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1]; k++)
+            D[(size_t)i * n + A->col[k]] = A->val[k];
+    for (int j = 0; j < n; j++) {
+        double s = D[(size_t)j * n + j];
+        for (int k = 0; k < j; k++) s -= D[(size_t)j * n + k] * D[(size_t)j * n + k];
+        if (!(s > 0)) return -1;
+        s = sqrt(s);
+        D[(size_t)j * n + j] = s;
+        for (int i = j + 1; i < n; i++) {
+            double t = D[(size_t)i * n + j];
+            for (int k = 0; k < j; k++) t -= D[(size_t)i * n + k] * D[(size_t)j * n + k];
+            D[(size_t)i * n + j] = t / s;
+        }
+    }
+    g->dense_n = n;
+    return 0;
+}
+
+int lub_amg_setup(lub_amg *g, const lub_csr *A)
+{
+    if (!A->finished) lub_bug("lub_amg_setup on a matrix not finished (lub_csr_finish)");
+    g->nlev = 0;
+    g->coarse_gs = 0;
+    g->nblocks = g->blocks > 0 ? g->blocks : omp_get_max_threads();
+    const lub_csr *M = A;
+    for (int l = 0;; l++) {
+        lub_amg_level *lv = &g->lev[l];
+        lv->A = M;
+        const int n = M->n;
+        if (n > lv->n_cap || !lv->tmp) {
+            lv->n_cap = n + n / 8 + 16;
+            lv->b = lub_realloc(lv->b, (size_t)lv->n_cap * sizeof *lv->b);
+            lv->x = lub_realloc(lv->x, (size_t)lv->n_cap * sizeof *lv->x);
+            lv->tmp = lub_realloc(lv->tmp, (size_t)lv->n_cap * sizeof *lv->tmp);
+        }
+        g->nlev = l + 1;
+        if (n <= g->coarse_max) return coarse_factor(g, M);
+        grow_int(&lv->agg, &lv->agg_cap, n);
+        lv->nc = aggregate(M, g->theta, lv->agg);
+        if (lv->nc > 0.9 * n || l == LUB_AMG_MAX_LEVELS - 1) {
+            /* no real coarsening (e.g. no off-diagonal couplings): this level is the
+             * coarsest, smoothed instead of solved */
+            g->coarse_gs = 1;
+            return 0;
+        }
+        galerkin(g, M, lv->agg, lv->nc, &g->lev[l + 1].own);
+        M = &g->lev[l + 1].own;
+    }
+}
+
+/* One Gauss-Seidel sweep (forward or backward) for A x = b from the current x, on the rows
+ * [r0, r1) only, reading the unknowns outside the range from xo ("hybrid" Gauss-Seidel:
+ * Gauss-Seidel inside a block, Jacobi between blocks, so that blocks run in parallel).
+ * xo == NULL: the unknowns outside are 0 (a sweep from x = 0). */
+static void gs_rows(const lub_csr *A, const double *b, double *x, const double *xo, int r0, int r1,
+                    int forward)
+{
+    const int *rp = A->row_ptr, *col = A->col, *diag = A->diag;
+    const double *val = A->val;
+    for (int t = r0; t < r1; t++) {
+        const int i = forward ? t : r0 + r1 - 1 - t;
+        double s = b[i];
+        for (int k = rp[i]; k < rp[i + 1]; k++) {
+            const int j = col[k];
+            if (j == i) continue;
+            if (j >= r0 && j < r1)
+                s -= val[k] * x[j];
+            else if (xo)
+                s -= val[k] * xo[j];
+        }
+        x[i] = s / val[diag[i]];
+    }
+}
+
+/* A sweep over all rows: one block per thread on the finest levels.  The forward sweep
+ * (from 0) and the backward sweep are transposes of each other, which keeps the V-cycle
+ * symmetric. */
+static void gs_sweep(lub_amg *g, lub_amg_level *lv, const double *b, double *x, int forward,
+                     int from_zero)
+{
+    const lub_csr *A = lv->A;
+    const int n = A->n;
+    const int nb = n > LUB_LINALG_OMP_MIN ? g->nblocks : 1;
+    if (nb == 1) {
+        gs_rows(A, b, x, NULL, 0, n, forward);
+        return;
+    }
+    const double *xo = NULL;
+    if (!from_zero) {
+        memcpy(lv->tmp, x, (size_t)n * sizeof *x);
+        xo = lv->tmp;
+    }
+#pragma omp parallel for schedule(static, 1) num_threads(nb)
+    for (int t = 0; t < nb; t++) {
+        int r0 = (int)((long)n * t / nb), r1 = (int)((long)n * (t + 1) / nb);
+        if (from_zero)
+            for (int i = r0; i < r1; i++) x[i] = 0.0;
+        gs_rows(A, b, x, xo, r0, r1, forward);
+    }
+}
+
+static void vcycle(lub_amg *g, int l, const double *b, double *x)
+{
+    lub_amg_level *lv = &g->lev[l];
+    const lub_csr *A = lv->A;
+    const int n = A->n;
+    if (l == g->nlev - 1) {
+        if (g->coarse_gs) { /* symmetric: forward from 0, then backward */
+            memset(x, 0, (size_t)n * sizeof *x);
+            gs_sweep(g, lv, b, x, 1, 1);
+            gs_sweep(g, lv, b, x, 0, 0);
+            return;
+        }
+        const double *D = g->dense;
+        for (int i = 0; i < n; i++) {
+            double s = b[i];
+            for (int k = 0; k < i; k++) s -= D[(size_t)i * n + k] * x[k];
+            x[i] = s / D[(size_t)i * n + i];
+        }
+        for (int i = n - 1; i >= 0; i--) {
+            double s = x[i];
+            for (int k = i + 1; k < n; k++) s -= D[(size_t)k * n + i] * x[k];
+            x[i] = s / D[(size_t)i * n + i];
+        }
+        return;
+    }
+    lub_amg_level *c = &g->lev[l + 1];
+    const int *agg = lv->agg;
+    if (n <= LUB_LINALG_OMP_MIN || g->nblocks == 1) memset(x, 0, (size_t)n * sizeof *x);
+    gs_sweep(g, lv, b, x, 1, 1);
+    /* restrict the residual: b_c = P^T (b - A x) */
+    double *res = lv->tmp;
+    const int *rp = A->row_ptr, *col = A->col;
+    const double *val = A->val;
+#pragma omp parallel for schedule(static) if (n > LUB_LINALG_OMP_MIN)
+    for (int i = 0; i < n; i++) {
+        double s = b[i];
+        for (int k = rp[i]; k < rp[i + 1]; k++) s -= val[k] * x[col[k]];
+        res[i] = s;
+    }
+    memset(c->b, 0, (size_t)lv->nc * sizeof *c->b);
+    for (int i = 0; i < n; i++) c->b[agg[i]] += res[i];
+    vcycle(g, l + 1, c->b, c->x);
+    const double alpha = g->alpha;
+    const double *xc = c->x;
+#pragma omp parallel for schedule(static) if (n > LUB_LINALG_OMP_MIN)
+    for (int i = 0; i < n; i++) x[i] += alpha * xc[agg[i]];
+    gs_sweep(g, lv, b, x, 0, 0);
+}
+
+void lub_amg_apply(lub_amg *g, const double *r, double *z)
+{
+    vcycle(g, 0, r, z);
+}
