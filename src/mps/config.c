@@ -7,7 +7,7 @@
  *     minPressureShift: true         # p_hat of T-14 in the gradient
  *     negativePressure: clip         # clip | keep
  *     dummyVelocity:    mirror       # mirror (no-slip ghost 2 U - u_i) | wall (U)
- *     pressure:         { alpha: 0, gamma: 5.0e-3 }          # T-9
+ *     pressure:         { alpha: 0, gamma: 0.2, predictor: 0.1 }   # T-9; lub_mps_step
  *     freeSurface:      { beta: 0.97, asymmetry: 0.2 }       # T-12 + geometric test
  *     neighbourSkin:    0.2
  *     lsmpsDetMin:      1.0e-2
@@ -40,6 +40,7 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->clip_negative = 1;
     c->alpha = 0.0;
     c->gamma = 0.2;
+    c->predictor = 0.1;
     c->beta = 0.97;
     c->asymmetry = 0.2;
     c->skin = 0.2;
@@ -90,6 +91,7 @@ static void read_schemes(lub_mps_config *c, const char *path)
     lub_node *p = lub_dict_map_or(r, "pressure");
     c->alpha = lub_dict_real_or(p, "alpha", 0.0, LUB_NONNEGATIVE);
     c->gamma = lub_dict_real_or(p, "gamma", 0.2, (lub_range){0.0, 1.0, 1, 0});
+    c->predictor = lub_dict_real_or(p, "predictor", c->predictor, LUB_BETWEEN(0.0, 1.0));
     lub_node *fs = lub_dict_map_or(r, "freeSurface");
     c->beta = lub_dict_real_or(fs, "beta", 0.97, (lub_range){0.0, 1.0, 1, 1});
     c->asymmetry = lub_dict_real_or(fs, "asymmetry", 0.2, LUB_BETWEEN(0.0, 10.0));

@@ -4,6 +4,8 @@
  *
  *     1. neighbour lists at r^k (cell-linked list, kept with a skin)
  *     2. viscosity and body force -> u*           explicit (T-7) or Crank-Nicolson (T-31)
+ *        (pressure predictor: with the force -G/rho of the running mean G of the pressure
+ *        gradient, which is then added back: u* += dt G / rho)
  *     3. temporary positions r* = r^k + u* dt      (T-8); walls move with their velocity
  *     4. PND n* at r*                              (T-11)
  *     5. free surface: n* < beta n0, refined by a geometric test   (T-12)
@@ -11,6 +13,19 @@
  *     7. pressure gradient                         standard (T-13, T-14) or LSMPS (T-15)
  *     8. u^{k+1} = u* - dt/rho grad p, r^{k+1} = r* + (u^{k+1} - u*) dt   (T-16, T-17)
  *     9. collision, periodic wrap, checks
+ *
+ * Pressure predictor (schemes.yaml pressure.predictor, not in the thesis).  Without it, a
+ * steady flow balances grad p / rho = nu lap(u*) with u* = u + dt grad p / rho: the viscous
+ * step acts on the pressure's velocity increment too, and at a no-slip wall the Laplacian of
+ * that increment is of order dt grad p / l0^2, an error of relative size nu dt / l0^2
+ * (9 in the thesis wedge).  The wedge pressure then comes out 20-25% low and the periodic
+ * step bearing's pressure gradient 22% low (tests/unit/mps_flow_test.c).  With the viscous
+ * step made under the force -G/rho, G the running mean of the pressure gradient at the
+ * particle (G += a (grad p - G) each step, a = predictor), and dt G / rho added back after
+ * it, the steady balance is exact and the pressure equation (PND source) is unchanged.  The
+ * running mean (rather than the last gradient) keeps the step-to-step noise of the
+ * pressure out of the feedback, which otherwise grows near free surfaces.  G is stored as
+ * the particle fields gradPx, gradPy (gradPz), so a restart is exact.
  *
  * Walls are one layer of wall particles (pressure solved) with dummy layers behind them (PND
  * only).  Wall and dummy particles move with the velocity of their patch (movingWalls).
@@ -39,6 +54,8 @@ typedef struct {
     int min_pressure_shift; /* p_hat of T-14 */
     int clip_negative;      /* negative pressure set to 0 after the solve */
     double alpha, gamma;    /* T-9 */
+    double predictor;       /* weight of the newest pressure gradient in the running mean
+                               that the viscous predictor feels (0: off; see lub_mps_step) */
     double beta;            /* free surface: n* < beta n0 (T-12) */
     double asymmetry;       /* geometric test: centroid offset / l0 above which a low-PND
                                particle is on the surface (0: PND test only) */
@@ -109,6 +126,8 @@ typedef struct {
     double *b, *x;         /* right-hand side and solution (pressure) */
     double *bv[3], *xv[3]; /* viscosity */
     double *grad[3];
+    double *gbar[3]; /* predictor: running mean of the pressure gradient (particle extra
+                        fields gradPx, gradPy, gradPz, so that it is saved and reordered) */
     double *lap;
     void *scratch;
     long steps; /* global step count (from the particle file) */
@@ -142,7 +161,10 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
  * time folder, so that a run restarted from that folder (whose lists are built afresh)
  * repeats the uninterrupted run exactly: lists kept with a skin hold the same pairs but sum
  * them in another order, and the iterative pressure solve would then stop at other iterates. */
-static inline void lub_mps_rebuild_lists(lub_mps *m) { m->built = 0; }
+static inline void lub_mps_rebuild_lists(lub_mps *m)
+{
+    m->built = 0;
+}
 
 /* Largest speed of all particles (fluid and moving walls). */
 double lub_mps_max_speed(const lub_mps *m);

@@ -53,6 +53,9 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
 
     size_t n = P->n;
     m->cap = n;
+    static const char *const gbar_names[3] = {"gradPx", "gradPy", "gradPz"};
+    for (int d = 0; d < 3; d++)
+        m->gbar[d] = c->predictor > 0 && d < m->dim ? lub_particles_extra(P, gbar_names[d]) : NULL;
     for (int d = 0; d < 3; d++) {
         m->us[d] = alloc_doubles(n);
         m->bv[d] = alloc_doubles(n);
@@ -153,6 +156,42 @@ static void begin_rows(lub_mps *m, int nrows)
  * slip velocity of a few percent of u_max).  With `dummyVelocity: mirror` (default) a dummy
  * j seen from fluid particle i takes the ghost value 2 U_j - u_i, i.e. the pair term
  * w_ij (u_j - u_i) becomes 2 w_ij (U_j - u_i); `wall` keeps U_j. */
+/* Pressure gradient of the fluid particles (T-13 or T-15) from P->p at the current
+ * positions; returns the number of LSMPS fallbacks. */
+static size_t pressure_gradient(lub_mps *m, double *const grad[3])
+{
+    const lub_particles *P = m->P;
+    lub_mps_mask gm = {P->kind, K_FLUID, K_FLUID | K_WALL};
+    if (m->c.gradient == LUB_GRADIENT_LSMPS)
+        return lub_mps_gradient_lsmps(&m->nb, &gm, m->n0, m->c.min_pressure_shift,
+                                      m->c.lsmps_det_min, P->p, grad);
+    lub_mps_gradient(&m->nb, &gm, m->n0, m->c.min_pressure_shift, P->p, grad);
+    return 0;
+}
+
+/* out_i = (f_i + sum_j w_ij f_j / sum_j w_ij) / 2 over the fluid neighbours j of each fluid
+ * particle i (out_i = f_i without any): a smoothing that keeps linear fields in a full
+ * neighbourhood and damps the particle-scale noise of f by half or more. */
+static void smooth_fluid(lub_mps *m, double *const f[3], double *const out[3])
+{
+    const lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    const int dim = m->dim;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->kind[i] != LUB_FLUID) continue;
+        double sw = 0, s[3] = {0, 0, 0};
+        for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+            const size_t j = nb->j[q];
+            const double w = nb->w[q];
+            if (w <= 0 || P->kind[j] != LUB_FLUID) continue;
+            sw += w;
+            for (int d = 0; d < dim; d++) s[d] += w * f[d][j];
+        }
+        for (int d = 0; d < dim; d++) out[d][i] = sw > 0 ? 0.5 * (f[d][i] + s[d] / sw) : f[d][i];
+    }
+}
+
 static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
 {
     lub_particles *P = m->P;
@@ -161,6 +200,11 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
     const double *g = m->c.g;
     lub_timer_start(&m->tm, LUB_T_VISCOSITY);
     for (int d = 0; d < 3; d++) memcpy(m->us[d], P->u[d], n * sizeof(double));
+    /* pressure predictor: the viscous step feels the running mean of the pressure gradient,
+     * smoothed over the fluid neighbours (m->grad is free until the gradient phase) */
+    const double rinv = m->c.predictor > 0 ? 1.0 / m->c.rho : 0.0;
+    double *const *gold = rinv != 0.0 ? m->grad : NULL;
+    if (gold) smooth_fluid(m, m->gbar, m->grad);
     if (m->c.viscosity == LUB_VISCOSITY_EXPLICIT) {
         /* (T-3, T-7) with the dummy particles' ghost velocity (see dummy_velocity) */
         const double cl = 2.0 * dim / (m->lambda0 * m->n0), nu = m->c.nu;
@@ -176,7 +220,8 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
                 double f = P->kind[j] == LUB_DUMMY ? gm : 1.0;
                 for (int d = 0; d < dim; d++) acc[d] += f * w * (P->u[d][j] - P->u[d][i]);
             }
-            for (int d = 0; d < dim; d++) m->us[d][i] += dt * (nu * cl * acc[d] + g[d]);
+            for (int d = 0; d < dim; d++)
+                m->us[d][i] += dt * (nu * cl * acc[d] + g[d] - (gold ? rinv * gold[d][i] : 0.0));
         }
     } else if (m->c.viscosity == LUB_VISCOSITY_CN) {
         /* (T-31): u*_i - (dt nu/2) <lap u*>_i = u_i + (dt nu/2) <lap u^k>_i + dt g, with the
@@ -215,7 +260,8 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
             col[0] = r;
             val[0] = 1.0 + k * wsum;
             for (int d = 0; d < dim; d++) {
-                m->bv[d][r] = P->u[d][i] + k * rhs[d] + dt * g[d];
+                m->bv[d][r] =
+                    P->u[d][i] + k * rhs[d] + dt * (g[d] - (gold ? rinv * gold[d][i] : 0.0));
                 m->xv[d][r] = P->u[d][i]; /* initial guess */
             }
         }
@@ -237,12 +283,20 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
         for (int d = 0; d < dim; d++)
 #pragma omp parallel for schedule(static)
             for (int r = 0; r < nf; r++) m->us[d][m->prow[r]] = m->xv[d][r];
-    } else if (m->c.gravity) {
+    } else if (m->c.gravity || rinv != 0.0) {
         for (int d = 0; d < dim; d++)
 #pragma omp parallel for schedule(static)
             for (size_t i = 0; i < n; i++)
-                if (P->kind[i] == LUB_FLUID) m->us[d][i] += dt * g[d];
+                if (P->kind[i] == LUB_FLUID)
+                    m->us[d][i] += dt * (g[d] - (gold ? rinv * gold[d][i] : 0.0));
     }
+    if (rinv != 0.0)
+        /* u* is the velocity the viscous step gives under the last pressure gradient; the
+         * pressure equation below works, as usual, on u* without that gradient */
+        for (int d = 0; d < dim; d++)
+#pragma omp parallel for schedule(static)
+            for (size_t i = 0; i < n; i++)
+                if (P->kind[i] == LUB_FLUID) m->us[d][i] += dt * rinv * gold[d][i];
     lub_timer_stop(&m->tm, LUB_T_VISCOSITY);
     return 0;
 }
@@ -526,12 +580,7 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
 
     /* 7. gradient, 8. correction (T-16, T-17) */
     lub_timer_start(&m->tm, LUB_T_GRADIENT);
-    lub_mps_mask gm = {P->kind, K_FLUID, K_FLUID | K_WALL};
-    if (m->c.gradient == LUB_GRADIENT_LSMPS)
-        m->st.nfallback = lub_mps_gradient_lsmps(&m->nb, &gm, m->n0, m->c.min_pressure_shift,
-                                                 m->c.lsmps_det_min, P->p, m->grad);
-    else
-        lub_mps_gradient(&m->nb, &gm, m->n0, m->c.min_pressure_shift, P->p, m->grad);
+    m->st.nfallback = pressure_gradient(m, m->grad);
     const double f = dt / m->c.rho;
     for (int d = 0; d < dim; d++) {
         double *u = P->u[d], *x = P->x[d];
@@ -541,6 +590,16 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
             if (P->kind[i] != LUB_FLUID) continue;
             u[i] = us[i] - f * gr[i];
             x[i] += (u[i] - us[i]) * dt;
+        }
+    }
+    if (m->c.predictor > 0) {
+        const double a = m->c.predictor;
+        for (int d = 0; d < dim; d++) {
+            double *gb = m->gbar[d];
+            const double *gr = m->grad[d];
+#pragma omp parallel for schedule(static)
+            for (size_t i = 0; i < n; i++)
+                if (P->kind[i] == LUB_FLUID) gb[i] += a * (gr[i] - gb[i]);
         }
     }
     lub_timer_stop(&m->tm, LUB_T_GRADIENT);

@@ -73,14 +73,14 @@ lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
                     len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", p ? ", " : "",
                                             r->P.patch_names[p]);
                 lub_node_error(lub_dict_get(d, "patch"),
-                               "function '%s': no patch '%s' in the particles (patches: %s)",
-                               name, patch, list);
+                               "function '%s': no patch '%s' in the particles (patches: %s)", name,
+                               patch, list);
             }
             o->from = lub_dict_real_or(d, "from", r->mps.lo[0], LUB_ANY);
             o->to = lub_dict_real_or(d, "to", r->mps.hi[0], LUB_ANY);
             if (!(o->to > o->from))
-                lub_node_error(d, "function '%s': 'to' (%g) must be greater than 'from' (%g)",
-                               name, o->to, o->from);
+                lub_node_error(d, "function '%s': 'to' (%g) must be greater than 'from' (%g)", name,
+                               o->to, o->from);
             o->bin = lub_dict_real_or(d, "bin", 4 * r->mps.l0, LUB_POSITIVE);
             o->t0 = lub_dict_real_or(d, "timeStart", 0.0, LUB_NONNEGATIVE);
             o->t1 = lub_dict_real_or(d, "timeEnd", INFINITY, LUB_NONNEGATIVE);

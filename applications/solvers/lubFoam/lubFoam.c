@@ -20,7 +20,10 @@
 #include "lubFoam.h"
 
 static volatile sig_atomic_t stop_signal = 0;
-static void on_signal(int sig) { stop_signal = sig; }
+static void on_signal(int sig)
+{
+    stop_signal = sig;
+}
 
 static void format_hms(double s, char *buf, size_t size)
 {
@@ -100,6 +103,15 @@ static void print_header(const lubfoam_run *r)
     lub_message("Solvers: p %s; U %s", ps, vs);
 }
 
+/* Viscosity iterations of the last step: the sum over the velocity components (0 when the
+ * viscosity is explicit or absent). */
+static int viscosity_iterations(const lub_mps *m)
+{
+    int it = 0;
+    for (int d = 0; d < m->dim; d++) it += m->st.v[d].iterations;
+    return it;
+}
+
 static void log_line(const lubfoam_run *r, long steps_done, double wall0, double pit_sum)
 {
     const lub_mps *m = &r->mps;
@@ -108,10 +120,10 @@ static void log_line(const lubfoam_run *r, long steps_done, double wall0, double
     char eta[32];
     format_hms(frac > 0 ? el * (1 - frac) / frac : NAN, eta, sizeof eta);
     lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g p %3d it %8.2e (mean %.1f)  "
-                "surf %-6zu ETA %s",
+                "U %3d it  surf %-6zu ETA %s",
                 r->t, 100 * frac, r->step, r->dt, m->st.umax * r->dt / m->l0, m->st.p.iterations,
                 m->st.p.residual, steps_done ? pit_sum / (double)steps_done : 0.0,
-                m->st.nsurface, eta);
+                viscosity_iterations(m), m->st.nsurface, eta);
 }
 
 static void progress_bar(const lubfoam_run *r, long steps_done, double wall0)
@@ -129,7 +141,7 @@ static void progress_bar(const lubfoam_run *r, long steps_done, double wall0)
 }
 
 /* Cost summary on the log and in postProcessing/cost/<startTime>/cost.dat. */
-static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum)
+static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, double vit_sum)
 {
     const lub_mps *m = &r->mps;
     double ps = (double)r->P.n * (double)steps;
@@ -148,29 +160,38 @@ static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum)
     char names[512];
     size_t len = (size_t)snprintf(names, sizeof names,
                                   "wallTime steps particles particleSteps usPerParticleStep "
-                                  "threads meanPressureIterations");
+                                  "threads meanPressureIterations meanViscosityIterations");
     for (int k = 0; k < LUB_T_COUNT; k++)
         len += (size_t)snprintf(names + len, sizeof names - len, " %s", lub_mps_phase_names[k]);
     lub_table_write_header(fp, names);
-    double row[7 + LUB_T_COUNT] = {wall, (double)steps, (double)r->P.n, ps, us,
-                                   (double)omp_get_max_threads(),
-                                   steps ? pit_sum / (double)steps : 0.0};
-    for (int k = 0; k < LUB_T_COUNT; k++) row[7 + k] = m->tm.seconds[k];
-    lub_table_write_row(fp, row, 7 + LUB_T_COUNT);
+    enum { NFIXED = 8 };
+    double row[NFIXED + LUB_T_COUNT] = {wall,
+                                        (double)steps,
+                                        (double)r->P.n,
+                                        ps,
+                                        us,
+                                        (double)omp_get_max_threads(),
+                                        steps ? pit_sum / (double)steps : 0.0,
+                                        steps ? vit_sum / (double)steps : 0.0};
+    for (int k = 0; k < LUB_T_COUNT; k++) row[NFIXED + k] = m->tm.seconds[k];
+    lub_table_write_row(fp, row, NFIXED + LUB_T_COUNT);
     if (lub_atomic_close(&af) != 0) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
 }
 
 int main(int argc, char **argv)
 {
+    /* A log file (runApplication, `> log`) is followed with tail -f: one line at a time. */
+    if (!isatty(STDOUT_FILENO)) setvbuf(stdout, NULL, _IOLBF, 0);
     lub_program_info info = {
         .name = "lubFoam",
         .summary = "semi-implicit MPS solver for thin-film lubrication",
         .usage = "[OPTIONS]",
-        .description = "  Starts from the time folder chosen by startFrom in system/controlDict.yaml,\n"
-                       "  advances to endTime (or nSteps), writes time folders and the tables of\n"
-                       "  the function objects, and reports its cost in\n"
-                       "  postProcessing/cost/<startTime>/cost.dat.  SIGINT/SIGTERM write the\n"
-                       "  current state and exit 0.",
+        .description =
+            "  Starts from the time folder chosen by startFrom in system/controlDict.yaml,\n"
+            "  advances to endTime (or nSteps), writes time folders and the tables of\n"
+            "  the function objects, and reports its cost in\n"
+            "  postProcessing/cost/<startTime>/cost.dat.  SIGINT/SIGTERM write the\n"
+            "  current state and exit 0.",
         .dictionaries = "system/controlDict.yaml\nsystem/particleGenDict.yaml (domain)\n"
                         "system/schemes.yaml\nsystem/solution.yaml (optional)\n"
                         "constant/transportProperties.yaml\nconstant/models.yaml",
@@ -208,7 +229,7 @@ int main(int argc, char **argv)
     const double wall0 = lub_wtime();
     const long step0 = r.step;
     long steps = 0;
-    double pit_sum = 0, last_bar = 0;
+    double pit_sum = 0, vit_sum = 0, last_bar = 0;
     int warned_courant = 0, status = LUB_EXIT_OK;
 
     while (!lub_control_finished(&r.ctl, r.t, steps, r.dt)) {
@@ -224,8 +245,8 @@ int main(int argc, char **argv)
         if (s != LUB_STEP_OK) {
             if (tty) fputc('\n', stdout);
             fflush(stdout);
-            fprintf(stderr, "lubFoam: error: step %ld (t = %.9g s): %s\n", r.step + 1,
-                    r.t + r.dt, msg);
+            fprintf(stderr, "lubFoam: error: step %ld (t = %.9g s): %s\n", r.step + 1, r.t + r.dt,
+                    msg);
             fprintf(stderr, "lubFoam: the last good state is the newest time folder\n");
             status = LUB_EXIT_RUN;
             break;
@@ -234,6 +255,7 @@ int main(int argc, char **argv)
         r.step++;
         steps++;
         pit_sum += r.mps.st.p.iterations;
+        vit_sum += viscosity_iterations(&r.mps);
         double co = r.mps.st.umax * r.dt / r.mps.l0;
         if (!r.ctl.adjust_time_step && co > r.ctl.max_courant && !warned_courant) {
             lub_warning("step %ld: Courant number %.3g exceeds maxCourant %g (u_max %g m/s)",
@@ -263,7 +285,7 @@ int main(int argc, char **argv)
         }
     }
     if (tty) fputc('\n', stdout);
-    write_cost(&r, steps, lub_wtime() - wall0, pit_sum);
+    write_cost(&r, steps, lub_wtime() - wall0, pit_sum, vit_sum);
     lubfoam_functions_free(fos);
     lub_mps_free(&r.mps);
     lub_particles_free(&r.P);

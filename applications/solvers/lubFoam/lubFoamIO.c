@@ -48,7 +48,8 @@ void lubfoam_read_start(lubfoam_run *r)
     r->dt = c->delta_t;
 
     /* uniform/state.yaml: the exact time and time step of a run that wrote this folder */
-    lub_dict *st = lub_dict_read_optional(lub_case_pathf(&r->cs, path, "%s/uniform/state.yaml", name));
+    lub_dict *st =
+        lub_dict_read_optional(lub_case_pathf(&r->cs, path, "%s/uniform/state.yaml", name));
     if (st) {
         lub_node *root = lub_dict_root(st);
         r->t = lub_dict_real(root, "time", LUB_NONNEGATIVE);
