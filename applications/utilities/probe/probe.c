@@ -1,0 +1,260 @@
+/* probe: sample particle fields from the time folders of a case (design.md, issue 5).
+ *
+ *     probe wallPressure -patch cylinder -bin 2.5e-5 -average 0.024:0.030
+ *     probe line -field p -from -0.004 -to 0.003 -bin 2.5e-5 -latestTime | postErr - ref.dat
+ *     probe points -field p,U -at "0 2e-5; 1e-4 2e-5"
+ *     probe film -bin 2e-5
+ *     probe totals
+ *     probe                      (every set of system/probeDict.yaml)
+ *
+ * The sampling itself is src/post (shared with the solver's function objects); this program
+ * turns options or dictionary entries into sampling sets (probeDict.c), runs them over the
+ * selected time folders (probeRun.c) and writes the tables (probeOutput.c).
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/args.h"
+#include "core/error.h"
+#include "io/dict.h"
+#include "probe.h"
+
+static const char *description =
+    "Subcommands (one per run; without one, the sets of system/probeDict.yaml are run):\n"
+    "  wallPressure -patch NAME [-field LIST] [-bin DX] [-arc] [-from A -to B]\n"
+    "      the wall particles (kind wall, not the dummies) of a patch.  Without -bin one row\n"
+    "      per particle, sorted by x: '# x y p' (with -arc: '# s x y p'; -average: per\n"
+    "      particle id); with -bin DX the mean per bin of x (or s): '# x p n'.  -arc:\n"
+    "      against the arc length s along the wall of system/particleGenDict.yaml (2-D\n"
+    "      cylinder: s = R theta from its lowest point, positive towards +x; plane,\n"
+    "      segment, polyline: length along it).\n"
+    "  line [-field LIST] [-from X0 -to X1] [-bin DX]\n"
+    "      the fluid particles binned by x: per bin the mean over the film thickness of each\n"
+    "      field and the count n of samples: '# x p n'.\n"
+    "  points -at 'x y; x y ...' [-field LIST]\n"
+    "      kernel-weighted (Shepard) mean at each point over the fluid and wall particles\n"
+    "      within the effective radius re (of the level of the nearest particle), with the\n"
+    "      MPS weight w(r) = (r/re - 1)^2 (T-6): sum w f / sum w.  '# x y p n' (n: particles\n"
+    "      used).  A point with no particle within re is left out with a warning.\n"
+    "  film [-from X0 -to X1] [-bin DX]\n"
+    "      the oil film per bin of x: '# x h surface bottom contact n'.  surface: y of the\n"
+    "      highest fluid particle (the free surface: MPS puts p = 0 on the surface particles);\n"
+    "      bottom: the wall surface under the film (highest wall particle below the lowest\n"
+    "      fluid particle, if closer than 2 l0; else that fluid particle); contact = 1 when a\n"
+    "      wall particle lies less than 2 l0 above the surface (the film fills the gap); h =\n"
+    "      (upper wall where contact, else surface) - bottom, so that under a cylinder h is\n"
+    "      the gap of reynoldsRef, at its narrowest in the bin (the lowest wall particle:\n"
+    "      where a wall rises by more than l0 across a bin, use narrower bins).  Comment\n"
+    "      lines give the inlet meniscus (upstream edge of the first contact bin, upstream\n"
+    "      by the sign of the mean fluid x-velocity) and the outlet meniscus (downstream\n"
+    "      edge of that contact run): to a bin width, and to l0/slope with the wall's slope\n"
+    "      there (particle rows are l0 apart, so a surface within 2 l0 of the wall is full).\n"
+    "  totals\n"
+    "      per time: '# t mass momentumX momentumY momentumZ kineticEnergy fluidParticles'\n"
+    "      over the fluid particles, particle mass rho l0^d (per unit depth in 2-D; rho from\n"
+    "      constant/transportProperties.yaml).\n"
+    "\n"
+    "Fields (-field, comma-separated): p, U (columns Ux Uy [Uz]), Ux, Uy, Uz, and the\n"
+    "optional fields of the particle files (pMean, pnd ...); default p.\n"
+    "Bins: [X0 + k DX, X0 + (k+1) DX), the last one closed at X1; x is the bin centre and\n"
+    "bins without samples are left out.  Default range: the domain's x-extent in\n"
+    "system/particleGenDict.yaml (with -arc, the extent of the patch); default DX: 4 l0 (line,\n"
+    "film).\n"
+    "\n"
+    "Times: every time folder unless -time, -latestTime or -noZero select some.  With one time,\n"
+    "or with -average, the output is one table that postErr reads directly.  With several\n"
+    "times and no -average a leading column t (the time folder) is added and the rows of all\n"
+    "times follow each other (one table: select one time, or average, for postErr).\n"
+    "-average T0:T1 pools the samples of the selected times in [T0, T1]: the mean per bin is\n"
+    "sum / count over all of them (as the wallPressure function object averages), n is the\n"
+    "count; points, film and totals average their per-time values over the times.\n"
+    "-dimensionless adds the thesis' X = x/sqrt(R h0) (S = s/sqrt(R h0) with -arc), P =\n"
+    "h0^1.5 p/(mu (U1+U2) sqrt(R)) for p, and H = h/h0 for the film (T-38, T-39), with R, h0,\n"
+    "U1 + U2 computed exactly as reynoldsRef does (its dictionaries are read).\n"
+    "\n"
+    "Output: a table ('# name[unit] ...' header, %.17g) on standard output, or -o FILE\n"
+    "(written atomically; a relative name is taken relative to the -case directory).\n"
+    "\n"
+    "Sets: system/probeDict.yaml names sampling sets, each a mapping with 'type' (a\n"
+    "subcommand) and the options as keys: patch, field (name, 'p,U' or [p, U]), from, to, bin,\n"
+    "arc, at ([[x, y], ...]), average ([T0, T1]), dimensionless.  'probe' runs every set and\n"
+    "'probe -set NAME' one (repeatable); each writes postProcessing/probe/<time>/<NAME>.dat per\n"
+    "time folder (averaged: under the window's last time; totals: one table under the first\n"
+    "time), or with -o FILE (one set) that file.  -average and -dimensionless on the command\n"
+    "line override the sets'.  Template: etc/templates/probeDict.yaml.\n"
+    "\n"
+    "Examples:\n"
+    "  probe line -field p -bin 2.5e-5 -latestTime | postErr - postProcessing/reynoldsRef/0/p.dat\n"
+    "  probe wallPressure -patch cylinder -bin 2.5e-5 -average 0.024:0.030 -dimensionless\n"
+    "  probe wallPressure -patch cylinder -arc -time 0.03\n"
+    "  probe points -field p,U -at '0 2e-5; 1e-4 2e-5' -time 0.01:0.02\n"
+    "  probe film -bin 2e-5 -latestTime\n"
+    "  probe totals -o totals.dat\n"
+    "  probe -set pWall -latestTime\n"
+    "\n"
+    "Errors (exit 1): an unknown subcommand, patch (the patches are listed) or field (the\n"
+    "fields of the file are listed), an option that does not apply to the subcommand, no time\n"
+    "folder selected or none in the -average window, -from >= -to, -bin <= 0, a malformed\n"
+    "-at point list or -average window, and bad dictionaries (file:line).";
+
+/* Which options each subcommand takes. */
+enum { O_PATCH, O_FIELD, O_FROM, O_TO, O_BIN, O_ARC, O_AT, O_DIMLESS, O_N };
+static const char *const opt_names[O_N] = {"-patch", "-field", "-from", "-to",
+                                           "-bin",   "-arc",   "-at",   "-dimensionless"};
+static const int applies[PROBE_NKINDS][O_N] = {
+    [PROBE_WALL] = {1, 1, 1, 1, 1, 1, 0, 1},   [PROBE_LINE] = {0, 1, 1, 1, 1, 0, 0, 1},
+    [PROBE_POINTS] = {0, 1, 0, 0, 0, 0, 1, 1}, [PROBE_FILM] = {0, 0, 1, 1, 1, 0, 0, 1},
+    [PROBE_TOTALS] = {0, 0, 0, 0, 0, 0, 0, 0},
+};
+
+static const char *in_case(const lub_case *c, const char *path, char *buf)
+{
+    if (!path || strcmp(path, "-") == 0 || path[0] == '/' || strcmp(c->root, ".") == 0) return path;
+    return lub_case_path(c, buf, path);
+}
+
+static probe_kind find_kind(const char *name)
+{
+    for (int k = 0; probe_kind_names[k]; k++)
+        if (strcmp(name, probe_kind_names[k]) == 0) return (probe_kind)k;
+    const char *near = lub_closest(name, probe_kind_names, PROBE_NKINDS);
+    char hint[64] = "";
+    if (near) snprintf(hint, sizeof hint, " (did you mean '%s'?)", near);
+    lub_fatal("unknown subcommand '%s'%s; the subcommands are: wallPressure line points film "
+              "totals (or none: the sets of system/probeDict.yaml); see probe -help",
+              name, hint);
+}
+
+int main(int argc, char **argv)
+{
+    static const char *patch = NULL, *field = NULL, *at = NULL, *average = NULL, *out = NULL;
+    static double from = NAN, to = NAN, bin = NAN;
+    static int arc = 0, dimensionless = 0;
+    static lub_strlist set_names = {0};
+    lub_option opts[] = {
+        {"-patch", "NAME", "wallPressure: the wall patch", LUB_OPT_STR, &patch},
+        {"-field", "LIST", "fields, e.g. p or p,U or pMean (default p)", LUB_OPT_STR, &field},
+        {"-from", "X0", "start of the x-range (with -arc: of s)", LUB_OPT_REAL, &from},
+        {"-to", "X1", "end of the x-range", LUB_OPT_REAL, &to},
+        {"-bin", "DX", "bin width (wallPressure: bins instead of one row per particle)",
+         LUB_OPT_REAL, &bin},
+        {"-arc", NULL, "wallPressure: against the arc length s along the wall", LUB_OPT_FLAG, &arc},
+        {"-at", "'x y; x y'", "points: where to sample", LUB_OPT_STR, &at},
+        {"-average", "T0:T1", "average over the selected times in [T0, T1]", LUB_OPT_STR, &average},
+        {"-dimensionless", NULL, "add X (S), P, H columns (thesis T-38, T-39)", LUB_OPT_FLAG,
+         &dimensionless},
+        {"-set", "NAME", "run set NAME of system/probeDict.yaml (repeatable)", LUB_OPT_MULTI,
+         &set_names},
+        {"-o", "FILE", "write the table to FILE instead of standard output", LUB_OPT_STR, &out},
+        {0}};
+    lub_program_info info = {
+        .name = "probe",
+        .summary = "sample particle fields of the time folders: wall pressure, lines, points, "
+                   "film, totals",
+        .usage = "[SUBCOMMAND] [OPTIONS]",
+        .description = description,
+        .dictionaries = "system/probeDict.yaml (without a subcommand, or with -set)\n"
+                        "system/particleGenDict.yaml (default x-range; -arc)\n"
+                        "constant/transportProperties.yaml (totals: rho; -dimensionless)\n"
+                        "system/reynoldsRefDict.yaml, constant/models.yaml (-dimensionless)",
+        .time_selection = 1,
+        .has_case = 1,
+        .min_args = 0,
+        .max_args = 1};
+    lub_args a;
+    lub_args_parse(&a, argc, argv, &info, opts);
+
+    /* option values that are wrong whatever the set */
+    if (!isnan(bin) && !(bin > 0.0)) lub_fatal("-bin must be > 0, found %g", bin);
+    if (!isnan(from) && !isnan(to) && !(from < to))
+        lub_fatal("-from (%g) must be less than -to (%g)", from, to);
+    double t0 = NAN, t1 = NAN;
+    if (average && probe_parse_window(average, &t0, &t1))
+        lub_fatal("-average '%s': expected a time window T0:T1 with T0 <= T1, e.g. -average "
+                  "0.024:0.030",
+                  average);
+    int given[O_N] = {patch != NULL, field != NULL, !isnan(from), !isnan(to),
+                      !isnan(bin),   arc,           at != NULL,   dimensionless};
+
+    probe_ctx x;
+    memset(&x, 0, sizeof x);
+    x.a = &a;
+    lub_case_open(&x.c, a.case_dir);
+    char obuf[LUB_PATH_MAX];
+    const char *opath = in_case(&x.c, out, obuf);
+
+    if (a.npos == 1) {
+        /* a subcommand and its options */
+        probe_kind kind = find_kind(a.pos[0]);
+        if (set_names.n) lub_fatal("-set runs sets of system/probeDict.yaml: give no subcommand");
+        for (int o = 0; o < O_N; o++)
+            if (given[o] && !applies[kind][o])
+                lub_fatal("option '%s' does not apply to '%s'; see probe -help", opt_names[o],
+                          probe_kind_names[kind]);
+        if (kind == PROBE_WALL && !patch)
+            lub_fatal("wallPressure needs -patch NAME (a wall of the case, e.g. -patch cylinder)");
+        if (kind == PROBE_POINTS && !at)
+            lub_fatal("points needs -at 'x y; x y ...' (the points to sample)");
+        probe_spec s;
+        probe_spec_init(&s, kind, probe_kind_names[kind]);
+        s.patch = patch;
+        if (field) {
+            if (strlen(field) >= sizeof s.fields) lub_fatal("-field: the list is too long");
+            snprintf(s.fields, sizeof s.fields, "%s", field);
+        }
+        s.from = from;
+        s.to = to;
+        s.bin = bin;
+        s.arc = arc;
+        s.dimensionless = dimensionless;
+        if (average) s.average = 1, s.t0 = t0, s.t1 = t1;
+        char err[512];
+        if (at && probe_parse_points(&s, at, err, sizeof err)) {
+            probe_spec_free(&s);
+            lub_fatal("-at '%s': %s; e.g. -at '0 2e-5; 1e-4 2e-5'", at, err);
+        }
+        probe_sink k;
+        probe_sink_init(&k, &x.c, opath, 0, s.name);
+        probe_run(&x, &s, &k);
+        probe_sink_close(&k);
+        probe_spec_free(&s);
+    } else {
+        /* the sets of system/probeDict.yaml */
+        for (int o = 0; o < O_N; o++)
+            if (given[o] && o != O_DIMLESS)
+                lub_fatal("option '%s' belongs to a subcommand; the sets take their settings "
+                          "from system/probeDict.yaml",
+                          opt_names[o]);
+        probe_sets S;
+        probe_sets_read(&S, &x.c);
+        int *run = lub_calloc((size_t)S.n, sizeof *run);
+        if (set_names.n == 0)
+            for (int i = 0; i < S.n; i++) run[i] = 1;
+        for (size_t i = 0; i < set_names.n; i++) run[probe_sets_find(&S, set_names.items[i])] = 1;
+        int nrun = 0;
+        for (int i = 0; i < S.n; i++) nrun += run[i];
+        if (out && nrun > 1)
+            lub_fatal("-o FILE takes one set (%d would run); choose it with -set NAME", nrun);
+        for (int i = 0; i < S.n; i++) {
+            if (!run[i]) continue;
+            probe_spec *s = &S.sets[i];
+            if (dimensionless && s->kind != PROBE_TOTALS) s->dimensionless = 1;
+            if (average) s->average = 1, s->t0 = t0, s->t1 = t1, s->average_node = NULL;
+            probe_sink k;
+            probe_sink_init(&k, &x.c, opath, out == NULL, s->name);
+            probe_run(&x, s, &k);
+            probe_sink_close(&k);
+            if (k.files)
+                lub_message("set %-16s %-12s %zu file%s, the last %s", s->name,
+                            probe_kind_names[s->kind], k.files, k.files == 1 ? "" : "s",
+                            k.last_path);
+        }
+        free(run);
+        probe_sets_free(&S);
+    }
+    probe_ctx_free(&x);
+    lub_strlist_free(&set_names);
+    return 0;
+}

@@ -1,0 +1,721 @@
+/* probe: running one sampling set over its time folders (see probe.h).
+ *
+ * Each kind reads the first time folder to resolve what the set names (fields, patch, bins),
+ * then samples every time folder with src/post.  Without -average a table is written per time;
+ * with it, the samples of all times are pooled and one table is written at the end.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "core/error.h"
+#include "io/particles_io.h"
+#include "models/transport.h"
+#include "post/film.h"
+#include "post/sample.h"
+#include "probe.h"
+
+void probe_ctx_free(probe_ctx *x)
+{
+    if (x->geom_state > 0) lub_geometry_free(&x->geom);
+    x->geom_state = 0;
+}
+
+/* ---- the case's dictionaries, read when a set needs them ------------------------------ */
+
+/* system/particleGenDict.yaml: NULL when absent and not required. */
+static const lub_geometry *ctx_geometry(probe_ctx *x, const char *why)
+{
+    if (x->geom_state == 0) {
+        char path[LUB_PATH_MAX];
+        struct stat st;
+        lub_case_path(&x->c, path, "system/particleGenDict.yaml");
+        if (stat(path, &st) != 0) {
+            x->geom_state = -1;
+        } else {
+            lub_geometry_read(&x->geom, path);
+            x->geom_state = 1;
+        }
+    }
+    if (x->geom_state < 0 && why)
+        lub_fatal("%s needs the wall geometry of system/particleGenDict.yaml, which case '%s' "
+                  "does not have",
+                  why, x->c.root);
+    return x->geom_state > 0 ? &x->geom : NULL;
+}
+
+static const lub_refscales *ctx_scales(probe_ctx *x)
+{
+    if (!x->have_scales) {
+        char path[LUB_PATH_MAX];
+        struct stat st;
+        if (stat(lub_case_path(&x->c, path, "system/reynoldsRefDict.yaml"), &st) != 0)
+            lub_fatal("-dimensionless scales with R, h0 and U1 + U2 of the Reynolds reference, "
+                      "which reads system/reynoldsRefDict.yaml: case '%s' has none (template: "
+                      "etc/templates/reynoldsRefDict.yaml)",
+                      x->c.root);
+        lub_refscales_read(&x->scales, &x->c);
+        x->have_scales = 1;
+    }
+    return &x->scales;
+}
+
+static double ctx_rho(probe_ctx *x)
+{
+    if (!x->have_rho) {
+        char path[LUB_PATH_MAX];
+        double nu;
+        lub_transport_read(lub_case_path(&x->c, path, "constant/transportProperties.yaml"), &x->rho,
+                           &nu);
+        x->have_rho = 1;
+    }
+    return x->rho;
+}
+
+/* ---- one run -------------------------------------------------------------------------- */
+
+typedef struct {
+    probe_ctx *x;
+    probe_spec *s;
+    probe_sink *k;
+    lub_time *times;
+    size_t nt;
+    lub_particles P;         /* the time folder being sampled */
+    char file[LUB_PATH_MAX]; /* its particles.h5 */
+    lub_post_fields f;       /* resolved fields (wallPressure, line, points) */
+    const double *vals[LUB_POST_MAX_COLS];
+    int pcol;                /* column of p in f, or -1 */
+    const lub_refscales *sc; /* -dimensionless, else NULL */
+    probe_block b;
+} job;
+
+/* Times of a set: the command-line selection, cut to the averaging window. */
+static void job_times(job *j)
+{
+    const lub_args *a = j->x->a;
+    const probe_spec *s = j->s;
+    j->nt = lub_case_select_times(&j->x->c, a->time, a->latest_time, a->no_zero, &j->times);
+    if (!s->average) return;
+    size_t m = 0;
+    char avail[512] = "";
+    size_t len = 0;
+    for (size_t i = 0; i < j->nt; i++) {
+        double v = j->times[i].value, tol = 1e-9 * fmax(fabs(v), 1e-300);
+        if (len < sizeof avail - 16)
+            len += (size_t)snprintf(avail + len, sizeof avail - len, "%s%s", i ? " " : "",
+                                    j->times[i].name);
+        if (v >= s->t0 - tol && v <= s->t1 + tol) j->times[m++] = j->times[i];
+    }
+    if (m == 0) {
+        free(j->times);
+        probe_error(s->average_node,
+                    "%sno time folder of case '%s' in the averaging window [%g, %g] (selected "
+                    "times: %s)",
+                    s->average_node ? "" : "-average: ", j->x->c.root, s->t0, s->t1, avail);
+    }
+    j->nt = m;
+}
+
+static void job_read(job *j, size_t it)
+{
+    struct stat st;
+    lub_case_pathf(&j->x->c, j->file, "%s/particles.h5", j->times[it].name);
+    if (stat(j->file, &st) != 0)
+        lub_fatal("time folder '%s' of case '%s' has no particles.h5 (%s)", j->times[it].name,
+                  j->x->c.root, j->file);
+    lub_particles_read(&j->P, j->file);
+}
+
+/* Fields of the set, resolved against the first time folder. */
+static void job_fields(job *j)
+{
+    char err[1536];
+    if (lub_post_fields_parse(&j->f, j->s->fields, &j->P, err, sizeof err))
+        probe_error(j->s->field_node, "%s%s (in %s)", j->s->field_node ? "" : "-field: ", err,
+                    j->file);
+    j->pcol = -1;
+    for (int c = 0; c < j->f.n; c++)
+        if (j->f.col[c].src == LUB_POST_PRESSURE) j->pcol = c;
+}
+
+static void job_arrays(job *j)
+{
+    char err[256];
+    if (lub_post_fields_arrays(&j->f, &j->P, j->vals, err, sizeof err))
+        lub_fatal("%s: %s, which the set '%s' samples (it is in the first time folder, %s)",
+                  j->file, err, j->s->name, j->times[0].name);
+}
+
+/* Patch index of the set's patch in the current particles; fatal listing the patches. */
+static int job_patch(job *j)
+{
+    const probe_spec *s = j->s;
+    int p = lub_particles_find_patch(&j->P, s->patch);
+    if (p >= 0) return p;
+    const char *names[LUB_MAX_PATCHES];
+    char list[LUB_MAX_PATCHES * (LUB_NAME_MAX + 1)] = "";
+    size_t len = 0;
+    for (int k = 0; k < j->P.npatches; k++) {
+        names[k] = j->P.patch_names[k];
+        len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", k ? " " : "", names[k]);
+    }
+    const char *near = lub_closest(s->patch, names, (size_t)j->P.npatches);
+    char hint[LUB_NAME_MAX + 32] = "";
+    if (near) snprintf(hint, sizeof hint, " (did you mean '%s'?)", near);
+    probe_error(s->patch_node, "%sno patch '%s' in %s%s; the patches are: %s",
+                s->patch_node ? "" : "-patch: ", s->patch, j->file, hint,
+                j->P.npatches ? list : "none (no walls)");
+}
+
+/* Write the block of time `it` (or of the window, averaged). */
+static void job_emit(job *j, size_t it)
+{
+    size_t last = j->nt - 1;
+    if (j->s->average) {
+        probe_sink_write(j->k, &j->b, j->times[last].name, j->times[last].value);
+        return;
+    }
+    probe_sink_write(j->k, &j->b, j->times[it].name, j->times[it].value);
+}
+
+static void header_add(char *h, size_t size, const char *name)
+{
+    size_t len = strlen(h);
+    snprintf(h + len, size - len, "%s%s", len ? " " : "", name);
+}
+
+/* Default x-range of bins: the domain of particleGenDict.yaml, else the extent of the
+ * particles of the given kind (-1: all). */
+static void job_xrange(job *j, int kind)
+{
+    probe_spec *s = j->s;
+    if (!isnan(s->from) && !isnan(s->to)) return;
+    double lo = INFINITY, hi = -INFINITY;
+    const lub_geometry *g = ctx_geometry(j->x, NULL);
+    if (g) {
+        lo = g->dmin[0];
+        hi = g->dmax[0];
+    } else {
+        for (size_t i = 0; i < j->P.n; i++)
+            if (kind < 0 || j->P.kind[i] == kind) {
+                lo = fmin(lo, j->P.x[0][i]);
+                hi = fmax(hi, j->P.x[0][i]);
+            }
+    }
+    if (isnan(s->from)) s->from = lo;
+    if (isnan(s->to)) s->to = hi;
+}
+
+static void job_bins(job *j, lub_bins *b)
+{
+    probe_spec *s = j->s;
+    if (isnan(s->bin)) s->bin = 4.0 * j->P.levels[0].l0;
+    if (!isfinite(s->from) || !isfinite(s->to))
+        probe_error(s->node,
+                    "set '%s': no particles to bin (nothing gives the range; set -from "
+                    "and -to)",
+                    s->name);
+    if (!(s->from < s->to))
+        probe_error(s->node, "%s'from' (%.9g) must be less than 'to' (%.9g)",
+                    s->node ? "" : "-from, -to: ", s->from, s->to);
+    if (lub_bins_init(b, s->from, s->to, s->bin) != 0)
+        probe_error(s->node, "%sbin width %g on [%.9g, %.9g] gives more than %d bins",
+                    s->node ? "" : "-bin: ", s->bin, s->from, s->to, LUB_BINS_MAX);
+}
+
+/* Coordinate and scaled columns of a binned table: "x[m] <fields> n [X] [P]". */
+static void binned_header(job *j, const char *coord, const char *coord_dimless, char *h,
+                          size_t size)
+{
+    h[0] = '\0';
+    header_add(h, size, coord);
+    for (int c = 0; c < j->f.n; c++) header_add(h, size, j->f.col[c].column);
+    header_add(h, size, "n");
+    if (j->sc) {
+        header_add(h, size, coord_dimless);
+        if (j->pcol >= 0) header_add(h, size, "P");
+    }
+}
+
+static void binned_block(job *j, const lub_bins *bins, const lub_accum *acc, const char *coord,
+                         const char *coord_dimless)
+{
+    char h[2048];
+    binned_header(j, coord, coord_dimless, h, sizeof h);
+    int nc = 2 + j->f.n + (j->sc ? 1 + (j->pcol >= 0) : 0);
+    probe_block_begin(&j->b, h, nc);
+    double row[LUB_POST_MAX_COLS + 8];
+    for (int k = 0; k < bins->nbins; k++) {
+        if (acc->count[k] == 0.0) continue;
+        int m = 0;
+        double xc = lub_bins_centre(bins, k);
+        row[m++] = xc;
+        for (int c = 0; c < j->f.n; c++) row[m++] = lub_accum_mean(acc, k, c);
+        row[m++] = acc->count[k];
+        if (j->sc) {
+            row[m++] = xc / j->sc->sx;
+            if (j->pcol >= 0) row[m++] = lub_accum_mean(acc, k, j->pcol) * j->sc->sp;
+        }
+        probe_block_row(&j->b, row);
+    }
+}
+
+/* ---- line: fluid particles binned along x --------------------------------------------- */
+
+static void run_line(job *j)
+{
+    lub_bins bins;
+    lub_accum acc = {0};
+    for (size_t it = 0; it < j->nt; it++) {
+        job_read(j, it);
+        if (it == 0) {
+            job_fields(j);
+            job_xrange(j, LUB_FLUID);
+            job_bins(j, &bins);
+            lub_accum_init(&acc, bins.nbins, j->f.n);
+        }
+        job_arrays(j);
+        if (lub_sample_bins(&acc, &bins, &j->P, LUB_FLUID, -1, NULL, j->vals) == 0)
+            lub_warning("time %s: no fluid particle in [%g, %g]", j->times[it].name, bins.from,
+                        bins.to);
+        lub_particles_free(&j->P);
+        if (!j->s->average || it == j->nt - 1) {
+            binned_block(j, &bins, &acc, "x[m]", "X");
+            job_emit(j, it);
+            lub_accum_clear(&acc);
+        }
+    }
+    lub_accum_free(&acc);
+}
+
+/* ---- wallPressure: the wall particles of a patch -------------------------------------- */
+
+typedef struct {
+    uint64_t id;
+    int row;
+} id_row;
+
+static int id_cmp(const void *a, const void *b)
+{
+    uint64_t x = ((const id_row *)a)->id, y = ((const id_row *)b)->id;
+    return (x > y) - (x < y);
+}
+
+typedef struct {
+    double key;
+    int row;
+} key_row;
+
+static int key_cmp(const void *a, const void *b)
+{
+    const key_row *x = a, *y = b;
+    if (x->key != y->key) return x->key < y->key ? -1 : 1;
+    return (x->row > y->row) - (x->row < y->row);
+}
+
+/* Arc length of every wall particle of the patch into s[] (others: NAN). */
+static void arc_coords(job *j, const lub_wall *w, int patch, double *s)
+{
+    for (size_t i = 0; i < j->P.n; i++) {
+        s[i] = NAN;
+        if (j->P.kind[i] != LUB_WALL || j->P.patch[i] != patch) continue;
+        double x[3] = {j->P.x[0][i], j->P.x[1][i], j->P.x[2][i]};
+        lub_wall_arc(w, j->P.dim, x, &s[i]);
+    }
+}
+
+static const lub_wall *arc_wall(job *j)
+{
+    const probe_spec *s = j->s;
+    const lub_geometry *g = ctx_geometry(j->x, "-arc");
+    int w = lub_geometry_find_wall(g, s->patch);
+    if (w < 0)
+        probe_error(s->patch_node,
+                    "%s-arc: patch '%s' is not a wall of system/particleGenDict.yaml, so its "
+                    "arc length is unknown",
+                    s->patch_node ? "" : "-patch: ", s->patch);
+    double x0[3] = {0, 0, 0}, dummy;
+    if (lub_wall_arc(&g->walls[w], g->dim, x0, &dummy) != 0)
+        probe_error(s->node,
+                    "-arc: arc length is defined along 2-D cylinder, plane, segment and "
+                    "polyline walls; wall '%s' is not one of them%s",
+                    s->patch, g->dim == 3 ? " (the case is 3-D)" : "");
+    return &g->walls[w];
+}
+
+static void run_wall_binned(job *j)
+{
+    lub_bins bins;
+    lub_accum acc = {0};
+    const lub_wall *w = j->s->arc ? arc_wall(j) : NULL;
+    double *coord = NULL;
+    for (size_t it = 0; it < j->nt; it++) {
+        job_read(j, it);
+        int patch = job_patch(j);
+        if (w) {
+            coord = lub_realloc(coord, (j->P.n ? j->P.n : 1) * sizeof *coord);
+            arc_coords(j, w, patch, coord);
+        }
+        if (it == 0) {
+            job_fields(j);
+            if (w && (isnan(j->s->from) || isnan(j->s->to))) {
+                double lo = INFINITY, hi = -INFINITY;
+                for (size_t i = 0; i < j->P.n; i++)
+                    if (!isnan(coord[i])) lo = fmin(lo, coord[i]), hi = fmax(hi, coord[i]);
+                if (isnan(j->s->from)) j->s->from = lo;
+                if (isnan(j->s->to)) j->s->to = hi;
+            } else if (!w) {
+                job_xrange(j, LUB_WALL);
+            }
+            job_bins(j, &bins);
+            lub_accum_init(&acc, bins.nbins, j->f.n);
+        }
+        job_arrays(j);
+        if (lub_sample_bins(&acc, &bins, &j->P, LUB_WALL, patch, coord, j->vals) == 0)
+            lub_warning("time %s: no wall particle of patch '%s' in [%g, %g]", j->times[it].name,
+                        j->s->patch, bins.from, bins.to);
+        lub_particles_free(&j->P);
+        if (!j->s->average || it == j->nt - 1) {
+            binned_block(j, &bins, &acc, w ? "s[m]" : "x[m]", w ? "S" : "X");
+            job_emit(j, it);
+            lub_accum_clear(&acc);
+        }
+    }
+    free(coord);
+    lub_accum_free(&acc);
+}
+
+/* Unbinned: one row per wall particle (by id), sorted by its coordinate. */
+static void run_wall_particles(job *j)
+{
+    const probe_spec *s = j->s;
+    const lub_wall *w = s->arc ? arc_wall(j) : NULL;
+    double *coord = NULL;
+    id_row *ids = NULL;
+    key_row *order = NULL;
+    size_t nids = 0;
+    lub_accum acc = {0};
+    int dim = 0, ncoord = 0;
+    for (size_t it = 0; it < j->nt; it++) {
+        job_read(j, it);
+        int patch = job_patch(j);
+        coord = lub_realloc(coord, (j->P.n ? j->P.n : 1) * sizeof *coord);
+        if (w)
+            arc_coords(j, w, patch, coord);
+        else
+            memcpy(coord, j->P.x[0], j->P.n * sizeof *coord);
+        if (it == 0) {
+            job_fields(j);
+            dim = j->P.dim;
+            ncoord = (w ? 1 : 0) + dim;
+            ids = lub_malloc((j->P.n ? j->P.n : 1) * sizeof *ids);
+            for (size_t i = 0; i < j->P.n; i++)
+                if (j->P.kind[i] == LUB_WALL && j->P.patch[i] == patch) {
+                    ids[nids].id = j->P.id[i];
+                    ids[nids].row = (int)nids;
+                    nids++;
+                }
+            if (nids == 0)
+                probe_error(s->patch_node, "%spatch '%s' has no wall particles in %s",
+                            s->patch_node ? "" : "-patch: ", s->patch, j->file);
+            qsort(ids, nids, sizeof *ids, id_cmp);
+            lub_accum_init(&acc, (int)nids, ncoord + j->f.n);
+            order = lub_malloc(nids * sizeof *order);
+        }
+        job_arrays(j);
+        double row[LUB_POST_MAX_COLS + 8];
+        for (size_t i = 0; i < j->P.n; i++) {
+            if (j->P.kind[i] != LUB_WALL || j->P.patch[i] != patch) continue;
+            if ((!isnan(s->from) && coord[i] < s->from) || (!isnan(s->to) && coord[i] > s->to))
+                continue;
+            id_row key = {j->P.id[i], 0}, *hit = bsearch(&key, ids, nids, sizeof *ids, id_cmp);
+            if (!hit)
+                lub_fatal("%s: wall particle %llu of patch '%s' is not in the first time folder "
+                          "(%s); the wall particles changed: average with -bin",
+                          j->file, (unsigned long long)j->P.id[i], s->patch, j->times[0].name);
+            int m = 0;
+            if (w) row[m++] = coord[i];
+            for (int d = 0; d < dim; d++) row[m++] = j->P.x[d][i];
+            for (int c = 0; c < j->f.n; c++) row[m++] = j->vals[c][i];
+            lub_accum_add(&acc, hit->row, row);
+        }
+        lub_particles_free(&j->P);
+        if (s->average && it != j->nt - 1) continue;
+
+        /* the table, sorted by the (mean) coordinate */
+        char h[2048] = "";
+        static const char *const axes[3] = {"x[m]", "y[m]", "z[m]"};
+        if (w) header_add(h, sizeof h, "s[m]");
+        for (int d = 0; d < dim; d++) header_add(h, sizeof h, axes[d]);
+        for (int c = 0; c < j->f.n; c++) header_add(h, sizeof h, j->f.col[c].column);
+        if (j->sc) {
+            header_add(h, sizeof h, w ? "S" : "X");
+            if (j->pcol >= 0) header_add(h, sizeof h, "P");
+        }
+        int nc = ncoord + j->f.n + (j->sc ? 1 + (j->pcol >= 0) : 0);
+        probe_block_begin(&j->b, h, nc);
+        size_t nrow = 0;
+        for (size_t r = 0; r < nids; r++)
+            if (acc.count[r] > 0.0)
+                order[nrow++] = (key_row){lub_accum_mean(&acc, (int)r, 0), (int)r};
+        qsort(order, nrow, sizeof *order, key_cmp);
+        for (size_t q = 0; q < nrow; q++) {
+            int r = order[q].row, m = 0;
+            for (int c = 0; c < ncoord + j->f.n; c++) row[m++] = lub_accum_mean(&acc, r, c);
+            if (j->sc) {
+                row[m++] = lub_accum_mean(&acc, r, 0) / j->sc->sx;
+                if (j->pcol >= 0) row[m++] = lub_accum_mean(&acc, r, ncoord + j->pcol) * j->sc->sp;
+            }
+            probe_block_row(&j->b, row);
+        }
+        if (nrow == 0)
+            lub_warning("time %s: no wall particle of patch '%s' in the range", j->times[it].name,
+                        s->patch);
+        job_emit(j, it);
+        lub_accum_clear(&acc);
+    }
+    free(coord);
+    free(ids);
+    free(order);
+    lub_accum_free(&acc);
+}
+
+/* ---- points: kernel-weighted means at given points ------------------------------------ */
+
+static void run_points(job *j)
+{
+    const probe_spec *s = j->s;
+    lub_accum acc = {0};
+    int dim = 0;
+    for (size_t it = 0; it < j->nt; it++) {
+        job_read(j, it);
+        if (it == 0) {
+            job_fields(j);
+            dim = j->P.dim;
+            if (s->pts_dim != dim)
+                probe_error(s->at_node,
+                            "%sthe points have %d coordinates, but the case is %d-D (%s): give "
+                            "%s",
+                            s->at_node ? "" : "-at: ", s->pts_dim, dim, j->file,
+                            dim == 2 ? "'x y; x y ...'" : "'x y z; x y z ...'");
+            lub_accum_init(&acc, (int)s->npts, j->f.n + 1);
+        }
+        job_arrays(j);
+        double out[LUB_POST_MAX_COLS + 1];
+        for (size_t q = 0; q < s->npts; q++) {
+            double re = 0.0;
+            size_t used = lub_sample_point(&j->P, s->pts + 3 * q, j->vals, j->f.n, out, &re);
+            if (!used) {
+                char where[128];
+                const double *p = s->pts + 3 * q;
+                if (dim == 3)
+                    snprintf(where, sizeof where, "(%g, %g, %g)", p[0], p[1], p[2]);
+                else
+                    snprintf(where, sizeof where, "(%g, %g)", p[0], p[1]);
+                lub_warning("time %s: no fluid or wall particle within re = %g of point %zu %s: "
+                            "left out",
+                            j->times[it].name, re, q + 1, where);
+                continue;
+            }
+            out[j->f.n] = (double)used;
+            lub_accum_add(&acc, (int)q, out);
+        }
+        lub_particles_free(&j->P);
+        if (s->average && it != j->nt - 1) continue;
+
+        char h[2048] = "";
+        static const char *const axes[3] = {"x[m]", "y[m]", "z[m]"};
+        for (int d = 0; d < dim; d++) header_add(h, sizeof h, axes[d]);
+        for (int c = 0; c < j->f.n; c++) header_add(h, sizeof h, j->f.col[c].column);
+        header_add(h, sizeof h, "n");
+        if (j->sc) {
+            header_add(h, sizeof h, "X");
+            if (j->pcol >= 0) header_add(h, sizeof h, "P");
+        }
+        probe_block_begin(&j->b, h, dim + j->f.n + 1 + (j->sc ? 1 + (j->pcol >= 0) : 0));
+        double row[LUB_POST_MAX_COLS + 8];
+        for (size_t q = 0; q < s->npts; q++) {
+            if (acc.count[q] == 0.0) continue;
+            int m = 0;
+            for (int d = 0; d < dim; d++) row[m++] = s->pts[3 * q + (size_t)d];
+            for (int c = 0; c < j->f.n; c++) row[m++] = lub_accum_mean(&acc, (int)q, c);
+            /* samples: particles used, summed over the times */
+            row[m++] = acc.sum[q * (size_t)acc.ncols + (size_t)j->f.n];
+            if (j->sc) {
+                row[m++] = s->pts[3 * q] / j->sc->sx;
+                if (j->pcol >= 0) row[m++] = lub_accum_mean(&acc, (int)q, j->pcol) * j->sc->sp;
+            }
+            probe_block_row(&j->b, row);
+        }
+        job_emit(j, it);
+        lub_accum_clear(&acc);
+    }
+    lub_accum_free(&acc);
+}
+
+/* ---- film: thickness and free surface ------------------------------------------------- */
+
+static void run_film(job *j)
+{
+    const probe_spec *s = j->s;
+    lub_film film = {0};
+    lub_accum acc = {0};
+    enum { H, SURFACE, BOTTOM, CONTACT, N, NCOLS };
+    double men_in = 0.0, men_out = 0.0;
+    size_t nmen = 0, ntimes = 0;
+    for (size_t it = 0; it < j->nt; it++) {
+        job_read(j, it);
+        if (it == 0) {
+            job_xrange(j, -1);
+            lub_bins bins;
+            job_bins(j, &bins); /* validates the range and width */
+            if (lub_film_init(&film, s->from, s->to, s->bin) != 0) lub_bug("film bins");
+            lub_accum_init(&acc, film.bins.nbins, NCOLS);
+        }
+        lub_film_sample(&film, &j->P);
+        lub_particles_free(&j->P);
+        lub_film_row r;
+        size_t found = 0;
+        for (int k = 0; k < film.bins.nbins; k++) {
+            if (!lub_film_row_at(&film, k, &r)) continue;
+            double v[NCOLS] = {r.h, r.surface, r.bottom, (double)r.contact, (double)r.n};
+            lub_accum_add(&acc, k, v);
+            found++;
+        }
+        if (!found)
+            lub_warning("time %s: no fluid particle in [%g, %g]", j->times[it].name, film.bins.from,
+                        film.bins.to);
+        double a, b;
+        if (lub_film_meniscus(&film, &a, &b)) men_in += a, men_out += b, nmen++;
+        ntimes++;
+        if (s->average && it != j->nt - 1) continue;
+
+        char h[256] = "x[m] h[m] surface[m] bottom[m] contact n";
+        if (j->sc) header_add(h, sizeof h, "X H");
+        probe_block_begin(&j->b, h, 6 + (j->sc ? 2 : 0));
+        for (int k = 0; k < film.bins.nbins; k++) {
+            if (acc.count[k] == 0.0) continue;
+            double xc = lub_bins_centre(&film.bins, k);
+            double row[8] = {xc,
+                             lub_accum_mean(&acc, k, H),
+                             lub_accum_mean(&acc, k, SURFACE),
+                             lub_accum_mean(&acc, k, BOTTOM),
+                             lub_accum_mean(&acc, k, CONTACT),
+                             acc.sum[(size_t)k * NCOLS + N],
+                             0.0,
+                             0.0};
+            if (j->sc) {
+                row[6] = xc / j->sc->sx;
+                row[7] = row[1] / j->sc->h0;
+            }
+            probe_block_row(&j->b, row);
+        }
+        if (nmen) {
+            double xi = men_in / (double)nmen, xo = men_out / (double)nmen;
+            char of[96] = "";
+            if (ntimes > 1)
+                snprintf(of, sizeof of, " (mean of the %zu of %zu times with contact)", nmen,
+                         ntimes);
+            if (j->sc) {
+                probe_block_comment(&j->b, "inletMeniscus x = %.9g X = %.6g%s", xi, xi / j->sc->sx,
+                                    of);
+                probe_block_comment(&j->b, "outletMeniscus x = %.9g X = %.6g%s", xo, xo / j->sc->sx,
+                                    of);
+            } else {
+                probe_block_comment(&j->b, "inletMeniscus x = %.9g%s", xi, of);
+                probe_block_comment(&j->b, "outletMeniscus x = %.9g%s", xo, of);
+            }
+        } else {
+            probe_block_comment(&j->b, "inletMeniscus none (the film touches no upper wall)");
+        }
+        job_emit(j, it);
+        lub_accum_clear(&acc);
+        men_in = men_out = 0.0;
+        nmen = ntimes = 0;
+    }
+    lub_film_free(&film);
+    lub_accum_free(&acc);
+}
+
+/* ---- totals: one row per time --------------------------------------------------------- */
+
+static void run_totals(job *j)
+{
+    double rho = ctx_rho(j->x);
+    enum { NC = 7 };
+    double sum[NC] = {0};
+    int dim = 2;
+    for (size_t it = 0; it < j->nt; it++) {
+        job_read(j, it);
+        dim = j->P.dim;
+        lub_totals t;
+        lub_totals_compute(&t, &j->P, rho);
+        lub_particles_free(&j->P);
+        double row[NC] = {j->times[it].value, t.mass,    t.momentum[0],   t.momentum[1],
+                          t.momentum[2],      t.kinetic, (double)t.nfluid};
+        if (it == 0)
+            probe_block_begin(&j->b,
+                              dim == 2 ? "t[s] mass[kg/m] momentumX[kg/s] momentumY[kg/s] "
+                                         "momentumZ[kg/s] kineticEnergy[J/m] fluidParticles"
+                                       : "t[s] mass[kg] momentumX[kg*m/s] momentumY[kg*m/s] "
+                                         "momentumZ[kg*m/s] kineticEnergy[J] fluidParticles",
+                              NC);
+        if (j->s->average)
+            for (int c = 0; c < NC; c++) sum[c] += row[c];
+        else
+            probe_block_row(&j->b, row);
+    }
+    if (j->s->average) {
+        for (int c = 0; c < NC; c++) sum[c] /= (double)j->nt;
+        probe_block_row(&j->b, sum);
+        probe_block_comment(&j->b, "mean over the %zu time folders %s .. %s", j->nt,
+                            j->times[0].name, j->times[j->nt - 1].name);
+        job_emit(j, j->nt - 1);
+        return;
+    }
+    /* one table of all times: in postProcessing under the first time, like the function
+     * objects' time series */
+    probe_sink_write(j->k, &j->b, j->times[0].name, j->times[0].value);
+}
+
+/* ---- entry ---------------------------------------------------------------------------- */
+
+void probe_run(probe_ctx *x, probe_spec *s, probe_sink *k)
+{
+    job j;
+    memset(&j, 0, sizeof j);
+    j.x = x;
+    j.s = s;
+    j.k = k;
+    if (s->dimensionless && s->kind == PROBE_TOTALS)
+        probe_error(s->node, "-dimensionless does not apply to totals");
+    job_times(&j);
+    k->tcol = !k->per_time && j.nt > 1 && !s->average && s->kind != PROBE_TOTALS;
+    if (s->dimensionless) j.sc = ctx_scales(x);
+    switch (s->kind) {
+    case PROBE_WALL:
+        if (isnan(s->bin))
+            run_wall_particles(&j);
+        else
+            run_wall_binned(&j);
+        break;
+    case PROBE_LINE:
+        run_line(&j);
+        break;
+    case PROBE_POINTS:
+        run_points(&j);
+        break;
+    case PROBE_FILM:
+        run_film(&j);
+        break;
+    case PROBE_TOTALS:
+        run_totals(&j);
+        break;
+    default:
+        lub_bug("kind %d", (int)s->kind);
+    }
+    probe_block_free(&j.b);
+    free(j.times);
+}

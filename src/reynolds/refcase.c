@@ -1,0 +1,298 @@
+/* lubkit Reynolds reference of a case (see refcase.h).  Moved out of reynoldsRef.c so that
+ * probe -dimensionless uses the same R, h0 and U1 + U2. */
+#include "reynolds/refcase.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "models/models.h"
+#include "models/transport.h"
+#include "reynolds/reynolds.h"
+
+const char *const lub_refcase_ehl_modes[] = {"auto", "on", "off", NULL};
+
+static void settings_read(lub_refcase_settings *s, const char *path)
+{
+    s->dict = lub_dict_read(path);
+    lub_node *root = lub_dict_root(s->dict);
+    s->lower_node = lub_dict_get(root, "lowerWall");
+    s->lower = lub_dict_str(root, "lowerWall");
+    s->upper_node = lub_dict_get(root, "upperWall");
+    s->upper = lub_dict_str(root, "upperWall");
+    s->inlet_node = lub_dict_get(root, "inlet");
+    s->inlet = lub_dict_real(root, "inlet", LUB_ANY);
+    s->outlet_node = lub_dict_get(root, "outlet");
+    s->outlet = lub_dict_real(root, "outlet", LUB_ANY);
+    if (!(s->outlet > s->inlet))
+        lub_node_error(s->outlet_node, "'outlet' must be > inlet (%g), found '%s'", s->inlet,
+                       lub_node_text(s->outlet_node));
+    s->cells = lub_dict_int_or(root, "cells", 4000, 2, 10000000);
+    s->bc =
+        lub_dict_choice(root, "boundaryCondition", lub_reynolds_bc_names, LUB_REYNOLDS_BC_REYNOLDS);
+    s->exit_x = 0.0;
+    if (s->bc == LUB_REYNOLDS_BC_GIVEN_EXIT) {
+        lub_node *e = lub_dict_get(root, "exit");
+        s->exit_x = lub_dict_real(root, "exit", LUB_ANY);
+        if (!(s->exit_x > s->inlet && s->exit_x <= s->outlet))
+            lub_node_error(e, "'exit' must be in (inlet, outlet] = (%g, %g], found '%s'", s->inlet,
+                           s->outlet, lub_node_text(e));
+    } else {
+        lub_node *e = lub_dict_find(root, "exit");
+        if (e)
+            lub_node_error(e,
+                           "'exit' is used only with 'boundaryCondition: givenExit' (here "
+                           "'%s')",
+                           lub_reynolds_bc_names[s->bc]);
+    }
+    s->time = lub_dict_real_or(root, "time", 0.0, LUB_NONNEGATIVE);
+    s->tolerance = lub_dict_real_or(root, "tolerance", 1e-12, (lub_range){0.0, 1e-3, 1, 0});
+    s->max_iterations = lub_dict_int_or(root, "maxIterations", 0, 0, 1000000000);
+    s->bc_node = lub_dict_find(root, "boundaryCondition");
+    s->cells_node = lub_dict_find(root, "cells");
+    lub_node *se = lub_dict_map_or(root, "softEHL");
+    s->ehl_mode_node = lub_dict_find(se, "mode");
+    s->ehl_mode = lub_dict_choice(se, "mode", lub_refcase_ehl_modes, LUB_REFCASE_EHL_AUTO);
+    s->ehl_tolerance = lub_dict_real_or(se, "tolerance", 1e-8, (lub_range){0.0, 1e-3, 1, 0});
+    s->ehl_max_iterations = lub_dict_int_or(se, "maxIterations", 400, 1, 1000000);
+    lub_dict_finish(s->dict);
+}
+
+/* Wall index by name, fatal at the dictionary entry naming it. */
+static int find_wall(const lub_geometry *g, const char *name, lub_node *node)
+{
+    int w = lub_geometry_find_wall(g, name);
+    if (w >= 0) return w;
+    char list[1024] = "";
+    size_t len = 0;
+    const char *names[256] = {0};
+    int nn = g->nwalls < 256 ? g->nwalls : 256;
+    for (int k = 0; k < nn; k++) {
+        names[k] = g->walls[k].name;
+        if (len < sizeof list)
+            len += (size_t)snprintf(list + len, sizeof list - len, "%s%s", k ? ", " : "", names[k]);
+    }
+    const char *near = lub_closest(name, names, (size_t)nn);
+    lub_node_error(node, "'%s' is not a wall of system/particleGenDict.yaml%s%s%s (walls: %s)",
+                   name, near ? " (did you mean '" : "", near ? near : "", near ? "'?)" : "",
+                   nn ? list : "none");
+}
+
+void lub_refcase_read(lub_refcase *rc, const lub_case *c)
+{
+    char path[LUB_PATH_MAX];
+    memset(rc, 0, sizeof *rc);
+    lub_refcase_settings *s = &rc->s;
+    settings_read(s, lub_case_path(c, path, "system/reynoldsRefDict.yaml"));
+
+    lub_geometry_read(&rc->g, lub_case_path(c, path, "system/particleGenDict.yaml"));
+    rc->wl = find_wall(&rc->g, s->lower, s->lower_node);
+    rc->wu = find_wall(&rc->g, s->upper, s->upper_node);
+    if (rc->wl == rc->wu)
+        lub_node_error(s->upper_node, "'upperWall' and 'lowerWall' are the same wall '%s'",
+                       s->upper);
+    rc->lower = &rc->g.walls[rc->wl];
+    rc->upper = &rc->g.walls[rc->wu];
+
+    lub_transport_read(lub_case_path(c, path, "constant/transportProperties.yaml"), &rc->rho,
+                       &rc->nu);
+    rc->mu = rc->rho * rc->nu;
+
+    lub_dict *md = lub_dict_read(lub_case_path(c, path, "constant/models.yaml"));
+    lub_models_declare(lub_dict_root(md));
+    rc->vel = lub_malloc((size_t)rc->g.nwalls * sizeof *rc->vel);
+    rc->moving = lub_malloc((size_t)rc->g.nwalls * sizeof *rc->moving);
+    lub_moving_walls_read(lub_dict_root(md), &rc->g, rc->vel, rc->moving);
+    int elastic = lub_elastic_wall_read(lub_dict_root(md), &rc->g, &rc->ew);
+    lub_dict_finish(md);
+    rc->u1 = rc->vel[rc->wl][0];
+    rc->u2 = rc->vel[rc->wu][0];
+
+    /* soft EHL: the elastic cylinder must be the upper wall, the exit free */
+    rc->ehl = elastic && s->ehl_mode != LUB_REFCASE_EHL_OFF;
+    if (s->ehl_mode == LUB_REFCASE_EHL_ON && !elastic)
+        lub_node_error(s->ehl_mode_node,
+                       "softEHL mode 'on' needs the elasticWall model in constant/models.yaml "
+                       "(patch, E, load; template etc/templates/models.yaml)");
+    if (rc->ehl && rc->ew.patch != rc->wu)
+        lub_node_error(rc->ew.patch_node,
+                       "elasticWall: patch '%s' must be the upper wall of the Reynolds reference "
+                       "('upperWall: %s' in system/reynoldsRefDict.yaml), or set 'softEHL: "
+                       "{mode: off}' there for the rigid reference",
+                       rc->ew.patch_name, s->upper);
+    if (rc->ehl && s->bc != LUB_REYNOLDS_BC_REYNOLDS)
+        lub_node_error(s->bc_node,
+                       "soft EHL solves the free exit: 'boundaryCondition' must be 'reynolds' "
+                       "(found '%s'), or set 'softEHL: {mode: off}' for the rigid reference",
+                       lub_reynolds_bc_names[s->bc]);
+    if (rc->ehl && s->cells > 8000)
+        lub_node_error(s->cells_node,
+                       "soft EHL solves a dense Newton system (time ~ cells^3, 0.05 s per "
+                       "iteration at 1000 cells): at most 8000 cells, found %ld (the scheme is "
+                       "second order: 1000-2000 cells are plenty)",
+                       s->cells);
+    /* a steady gap: the cylinder at rest, the lower wall sliding along itself */
+    const double *vl = rc->vel[rc->wl], *vu = rc->vel[rc->wu];
+    int flat = rc->lower->type == LUB_WALL_PLANE && fabs(rc->lower->normal[0]) < 1e-12;
+    if (rc->ehl && (vu[0] != 0.0 || vu[1] != 0.0 || vl[1] != 0.0 || (vl[0] != 0.0 && !flat)))
+        lub_node_error(rc->ew.node,
+                       "soft EHL is steady: the elastic cylinder '%s' must be at rest and the "
+                       "lower wall '%s' may only slide along x%s (constant/models.yaml "
+                       "movingWalls gives the cylinder (%g, %g) m/s, the lower wall (%g, %g) m/s)",
+                       rc->ew.patch_name, s->lower, flat ? "" : ", being a plane parallel to x",
+                       vu[0], vu[1], vl[0], vl[1]);
+    lub_dict_free(md);
+    rc->ew.node = rc->ew.patch_node = rc->ew.ramp_node = NULL; /* freed with md */
+}
+
+void lub_refcase_free(lub_refcase *rc)
+{
+    free(rc->vel);
+    free(rc->moving);
+    lub_dict_free(rc->s.dict);
+    lub_geometry_free(&rc->g);
+    memset(rc, 0, sizeof *rc);
+}
+
+/* Height of wall w at x, fatal (at the inlet or outlet entry) when the wall does not span x. */
+static double wall_y(const lub_refcase_settings *s, const lub_wall *w, double x, int upper)
+{
+    double y;
+    if (!lub_wall_height(w, x, upper, &y))
+        lub_node_error(x < 0.5 * (s->inlet + s->outlet) ? s->inlet_node : s->outlet_node,
+                       "the %s wall '%s' does not span [inlet, outlet] = [%g, %g]: no surface "
+                       "at x = %.9g",
+                       upper ? "upper" : "lower", w->name, s->inlet, s->outlet, x);
+    return y;
+}
+
+/* Slope dy/dx of a wall surface at x, by central differences inside [xa, xb]. */
+static double wall_slope(const lub_refcase_settings *s, const lub_wall *w, double x, int upper,
+                         double dx)
+{
+    double d = 1e-3 * dx, xl = fmax(x - d, s->inlet), xr = fmin(x + d, s->outlet);
+    return (wall_y(s, w, xr, upper) - wall_y(s, w, xl, upper)) / (xr - xl);
+}
+
+/* h(x) = (upper wall height) - (lower wall height) at nodes and faces. */
+static void gap_heights(lub_refgap *G, const lub_refcase *rc)
+{
+    const lub_refcase_settings *s = &rc->s;
+    int n = G->n = (int)s->cells;
+    G->xa = s->inlet;
+    G->xb = s->outlet;
+    double dx = G->dx = (G->xb - G->xa) / n;
+    G->h = lub_malloc((size_t)(n + 1) * sizeof *G->h);
+    G->hf = lub_malloc((size_t)n * sizeof *G->hf);
+    G->dhdt = lub_malloc((size_t)(n + 1) * sizeof *G->dhdt);
+    G->h0 = INFINITY;
+    G->x_h0 = G->xa;
+    int i_h0 = 0;
+    for (int i = 0; i <= 2 * n; i++) {
+        double x = i == 2 * n ? G->xb : G->xa + 0.5 * i * dx;
+        double gap = wall_y(s, rc->upper, x, 1) - wall_y(s, rc->lower, x, 0);
+        if (!(gap > 0.0)) {
+            lub_refgap_free(G);
+            lub_node_error(s->upper_node,
+                           "the gap between '%s' and '%s' is %s at x = %.9g: it must be > 0 "
+                           "on [inlet, outlet] = [%g, %g]",
+                           s->lower, s->upper, gap == 0.0 ? "zero" : "negative", x, s->inlet,
+                           s->outlet);
+        }
+        if (i % 2 == 0)
+            G->h[i / 2] = gap;
+        else
+            G->hf[i / 2] = gap;
+        if (gap < G->h0) {
+            G->h0 = gap;
+            G->x_h0 = x;
+            i_h0 = i;
+        }
+    }
+    /* the minimum between samples: vertex of the parabola through the smallest sample and its
+     * neighbours (half a cell apart) */
+    if (i_h0 > 0 && i_h0 < 2 * n) {
+        double gm = i_h0 % 2 ? G->h[i_h0 / 2] : G->hf[i_h0 / 2 - 1];
+        double gp = i_h0 % 2 ? G->h[i_h0 / 2 + 1] : G->hf[i_h0 / 2];
+        double curv = gm - 2.0 * G->h0 + gp;
+        if (curv > 0.0) {
+            G->x_h0 += 0.25 * dx * (gm - gp) / curv;
+            G->h0 -= (gp - gm) * (gp - gm) / (8.0 * curv);
+        }
+    }
+}
+
+/* dh/dt at fixed x for walls translating with velocities vl (lower) and vu (upper): the
+ * normal speeds, and each surface carried along x (-U dy/dx), which vanishes for walls
+ * parallel to x (the squeeze term of T-32). */
+static void gap_motion(lub_refgap *G, const lub_refcase *rc)
+{
+    const lub_refcase_settings *s = &rc->s;
+    const double *vl = rc->vel[rc->wl], *vu = rc->vel[rc->wu];
+    G->moving_shape = 0;
+    for (int i = 0; i <= G->n; i++) {
+        double x = G->xa + i * G->dx, r = vu[1] - vl[1];
+        if (vu[0] != 0.0) r -= vu[0] * wall_slope(s, rc->upper, x, 1, G->dx);
+        if (vl[0] != 0.0) r += vl[0] * wall_slope(s, rc->lower, x, 0, G->dx);
+        G->dhdt[i] = r;
+        G->moving_shape |= r != 0.0;
+    }
+}
+
+void lub_refgap_sample(lub_refgap *G, const lub_refcase *rc)
+{
+    memset(G, 0, sizeof *G);
+    gap_heights(G, rc);
+    gap_motion(G, rc);
+}
+
+void lub_refgap_free(lub_refgap *G)
+{
+    free(G->h);
+    free(G->hf);
+    free(G->dhdt);
+    G->h = G->hf = G->dhdt = NULL;
+}
+
+void lub_refcase_check_scales(const lub_refcase *rc)
+{
+    if (rc->upper->type != LUB_WALL_CYLINDER)
+        lub_node_error(rc->s.upper_node,
+                       "-dimensionless needs a cylinder as the upper wall (R is its "
+                       "radius), but '%s' is not a cylinder",
+                       rc->s.upper);
+    if (rc->u1 + rc->u2 == 0.0)
+        lub_node_error(rc->s.lower_node,
+                       "-dimensionless scales p with U1 + U2, which is 0 here (set the "
+                       "wall speeds in constant/models.yaml movingWalls)");
+}
+
+void lub_refcase_scales(const lub_refcase *rc, const lub_refgap *G, lub_refscales *d)
+{
+    lub_refcase_check_scales(rc);
+    d->radius = rc->upper->radius;
+    d->uref = rc->u1 + rc->u2;
+    if (rc->ehl) { /* T-54..T-58 */
+        d->h0 = rc->ew.b * rc->ew.b / rc->ew.radius;
+        d->sx = rc->ew.b;
+        d->sp = 1.0 / rc->ew.p_hertz;
+        return;
+    }
+    d->h0 = G->h0;
+    d->sx = sqrt(d->radius * G->h0);
+    d->sp = pow(G->h0, 1.5) / (rc->mu * d->uref * sqrt(d->radius));
+}
+
+void lub_refscales_read(lub_refscales *d, const lub_case *c)
+{
+    lub_refcase rc;
+    lub_refgap G;
+    lub_refcase_read(&rc, c);
+    lub_refcase_check_scales(&rc);
+    lub_refgap_sample(&G, &rc);
+    lub_refcase_scales(&rc, &G, d);
+    lub_refgap_free(&G);
+    lub_refcase_free(&rc);
+}
