@@ -15,9 +15,9 @@
  *
  * system/solution.yaml:
  *
- *     p: { solver: pcg, preconditioner: ic0, tolerance: 1e-8, maxIter: 2000,
+ *     p: { solver: pcg, preconditioner: amg, tolerance: 1e-8, maxIter: 2000,
  *          warmStart: true, onFailure: stop }          # stop | continue
- *     U: { solver: pcg, preconditioner: jacobi, tolerance: 1e-10, maxIter: 500 }
+ *     U: { solver: pcg, preconditioner: jacobi, tolerance: 1e-8, maxIter: 500 }
  */
 #include <math.h>
 #include <stdio.h>
@@ -49,10 +49,10 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->mirror_dummies = 1;
     c->p_solver = lub_linsolver_defaults();
     c->p_solver.pcg.tolerance = 1e-8;
-    c->p_solver.pcg.precond = LUB_PRECOND_IC0;
+    c->p_solver.pcg.precond = LUB_PRECOND_AMG;
     c->p_solver.pcg.warm_start = 1;
     c->v_solver = lub_linsolver_defaults();
-    c->v_solver.pcg.tolerance = 1e-10;
+    c->v_solver.pcg.tolerance = 1e-8;
     c->v_solver.pcg.precond = LUB_PRECOND_JACOBI;
     c->v_solver.pcg.warm_start = 1;
     c->viscosity = LUB_VISCOSITY_NONE;

@@ -83,7 +83,6 @@ void lub_neighbours_free(lub_neighbours *nb)
     free(nb->start);
     free(nb->j);
     for (int d = 0; d < 3; d++) free(nb->dx[d]), free(nb->xs[d]);
-    free(nb->r);
     free(nb->w);
     free(nb->perm);
     free(nb->cell);
@@ -119,8 +118,6 @@ static void reserve_pairs(lub_neighbours *nb, size_t npairs)
         free(nb->dx[d]);
         nb->dx[d] = lub_malloc(cap * sizeof(double));
     }
-    free(nb->r);
-    nb->r = lub_malloc(cap * sizeof(double));
     free(nb->w);
     nb->w = lub_malloc(cap * sizeof(double));
     nb->cap_pairs = cap;
@@ -317,7 +314,7 @@ static void fill_sweep(lub_neighbours *nb)
     uint32_t *restrict J = nb->j;
     const uint32_t *restrict perm = nb->perm;
     double *restrict DX = nb->dx[0], *restrict DY = nb->dx[1], *restrict DZ = nb->dx[2];
-    double *restrict R = nb->r, *restrict W = nb->w;
+    double *restrict W = nb->w;
     int mismatch = 0;
 #pragma omp parallel reduction(| : mismatch)
     {
@@ -347,7 +344,6 @@ static void fill_sweep(lub_neighbours *nb)
                     const double r = sqrt(dist2(dim, xs, k, p, d));
                     DX[q] = d[0], DY[q] = d[1];
                     if (dim == 3) DZ[q] = d[2];
-                    R[q] = r;
                     W[q] = lub_mps_weight(r, re);
                     J[q] = perm[k];
                 }
@@ -404,9 +400,7 @@ static inline void update_particle(lub_neighbours *nb, double *const x[3], size_
             nb->dx[d][k] = v;
             r2 += v * v;
         }
-        const double r = sqrt(r2);
-        nb->r[k] = r;
-        nb->w[k] = lub_mps_weight(r, re);
+        nb->w[k] = lub_mps_weight(sqrt(r2), re);
     }
 }
 

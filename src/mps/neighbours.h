@@ -8,8 +8,7 @@
  *     size_t escaped = lub_neighbours_build(&nb, n, P->x);            every step
  *     for (size_t i = 0; i < nb.n; i++)
  *         for (size_t k = nb.start[i]; k < nb.start[i + 1]; k++)
- *             j = nb.j[k], r_ij = (nb.dx[0][k], nb.dx[1][k], nb.dx[2][k]), |r_ij| = nb.r[k],
- *             w_ij = nb.w[k]
+ *             j = nb.j[k], r_ij = (nb.dx[0][k], nb.dx[1][k], nb.dx[2][k]), w_ij = nb.w[k]
  *     lub_neighbours_free(&nb);                                       at the end
  *
  * Lists are full (j is in i's list and i in j's), in the caller's particle order (CSR: the
@@ -17,8 +16,8 @@
  * cell, then by index within a cell: nearly ascending j once the particles are in cell order.  r_ij
  * = r_j - r_i is the minimum-image displacement in periodic directions.  Pairs are those with
  * |r_ij| < rs = re (1 + skin); w_ij = w(|r_ij|, re) (weight.h), so pairs beyond re (possible only
- * with skin > 0) are stored with w = 0.  The operators form |r_ij|^2 from r_ij rather than reading
- * r (the sweeps are memory-bound).
+ * with skin > 0) are stored with w = 0.  |r_ij| is not stored: the sweeps are memory-bound,
+ * and the operators that need it form it from r_ij.
  *
  * Cell order for cache locality: after lub_neighbours_bin (or _build), perm[k] is the index
  * of the k-th particle in cell order.  To sort the caller's structure-of-arrays data:
@@ -65,7 +64,6 @@ typedef struct {
     size_t *start;   /* [n + 1] */
     uint32_t *j;     /* [npairs] neighbour index */
     double *dx[3];   /* [npairs] r_j - r_i, minimum image; dx[2] is NULL in 2-D */
-    double *r;       /* [npairs] |r_ij| */
     double *w;       /* [npairs] w(|r_ij|, re) */
     uint32_t *perm;  /* [n] cell order: perm[k] = index of the k-th particle */
     size_t nescaped; /* particles outside the box in a non-periodic direction, or non-finite */

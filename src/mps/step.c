@@ -436,8 +436,10 @@ static void collision(lub_mps *m, double dt)
         double acc[3] = {0, 0, 0};
         if (P->kind[i] == LUB_FLUID) {
             for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
-                double r = nb->r[q];
-                if (r >= dc || r <= 0) continue;
+                double r2 = 0;
+                for (int d = 0; d < m->dim; d++) r2 += nb->dx[d][q] * nb->dx[d][q];
+                if (r2 >= dc * dc || r2 <= 0) continue;
+                const double r = sqrt(r2);
                 size_t j = nb->j[q];
                 double vn = 0, ev[3] = {0, 0, 0};
                 for (int d = 0; d < m->dim; d++) {
