@@ -47,16 +47,36 @@ static const char *wall_type_name(lub_wall_type t)
  * other walls beneath it.  Returns 0 when no wall lies beneath. */
 static int h0_from_geometry(const lub_geometry *g, const lub_elastic_wall *e, double *h0)
 {
+    double y;
+    if (!lub_elastic_floor(g, e, e->x_centre, &y)) return 0;
+    *h0 = e->y_lowest - y;
+    return 1;
+}
+
+int lub_elastic_floor(const lub_geometry *g, const lub_elastic_wall *e, double x, double *y)
+{
     double best = -INFINITY;
     double slack = 1e-12 * fmax(e->radius, fabs(e->y_lowest));
     for (int w = 0; w < g->nwalls; w++) {
-        double y;
-        if (w == e->patch || !lub_wall_height(&g->walls[w], e->x_centre, 0, &y)) continue;
-        if (y <= e->y_lowest + slack && y > best) best = y;
+        double yw;
+        if (w == e->patch || !lub_wall_height(&g->walls[w], x, 0, &yw)) continue;
+        if (yw <= e->y_lowest + slack && yw > best) best = yw;
     }
     if (!(best > -INFINITY)) return 0;
-    *h0 = e->y_lowest - best;
+    *y = best;
     return 1;
+}
+
+int lub_elastic_segment_widths(int n, const double *x, double fallback, double *w)
+{
+    for (int k = 1; k < n; k++)
+        if (!(x[k] > x[k - 1])) return -1;
+    if (n == 1) w[0] = fallback;
+    if (n < 2) return 0;
+    w[0] = x[1] - x[0];
+    w[n - 1] = x[n - 1] - x[n - 2];
+    for (int k = 1; k < n - 1; k++) w[k] = 0.5 * (x[k + 1] - x[k - 1]);
+    return 0;
 }
 
 int lub_elastic_wall_read(lub_node *root, const lub_geometry *g, lub_elastic_wall *e)

@@ -101,6 +101,24 @@ double lub_elastic_dh0(const lub_elastic_wall *e, double integral, double load);
 double lub_elastic_hertz_half_width(double load, double radius, double E);
 double lub_elastic_hertz_pressure(double load, double b);
 
+/* The surface beneath the cylinder at x: the highest surface (lub_wall_height, seen from
+ * above) of the walls of g other than the elastic patch that lies at or below the undeformed
+ * cylinder's lowest point.  Returns 1 and sets *y, or 0 when no such wall spans x.  At x_c
+ * this is the surface that the default h0 (the clearance) is measured from. */
+int lub_elastic_floor(const lub_geometry *g, const lub_elastic_wall *e, double x, double *y);
+
+/* Widths of the pressure segments of n points sorted by x (x[k] < x[k+1]): each point owns
+ * the half-way intervals to its neighbours, w_k = (x[k+1] - x[k-1]) / 2, and an end point
+ * the mirror of its inner half, w_0 = x[1] - x[0] (n = 1: w_0 = fallback).  On a uniform
+ * lattice every width is the spacing; sum_k p_k w_k is the trapezoid-like integral of p dx
+ * that the load balance uses.  Returns 0, or -1 when the points are not strictly sorted. */
+int lub_elastic_segment_widths(int n, const double *x, double fallback, double *w);
+
+/* Particle fields of the model in the particle solver (mps/elastic_wall.h; saved in
+ * particles.h5): the running mean of the wall pressure and the undeformed shape. */
+#define LUB_ELASTIC_FIELD_MEAN  "pWallMean"
+#define LUB_ELASTIC_FIELD_SHAPE "elasticShape"
+
 /* ---- influence coefficients ------------------------------------------------------------- */
 
 /* a(K) of T-47 for K >= 0 (a(1/2) = ln 1 - 1 + 0 = -1: x ln x -> 0), accurate to round-off

@@ -148,15 +148,13 @@ static void read_models(lub_mps_config *c, const char *path, const lub_particles
         lub_dict_real_or(col, "distance", c->collision_distance, (lub_range){0.0, 1.0, 1, 0});
     c->restitution = lub_dict_real_or(col, "restitution", c->restitution, LUB_UNIT);
 
-    const char *unsupported[] = {"elasticWall", "multiResolution"};
-    for (int k = 0; k < 2; k++) {
-        lub_node *m = lub_dict_find(r, unsupported[k]);
-        if (m)
-            lub_node_error(m,
-                           "model '%s' is not available in this version of lubFoam "
-                           "(remove it from %s)",
-                           unsupported[k], path);
-    }
+    /* elasticWall is read by mps/elastic_wall.c (it needs the geometry) */
+    lub_node *mr = lub_dict_find(r, "multiResolution");
+    if (mr)
+        lub_node_error(mr,
+                       "model 'multiResolution' is not available in this version of lubFoam "
+                       "(remove it from %s)",
+                       path);
     if (d) {
         lub_dict_finish(d);
         lub_dict_free(d);

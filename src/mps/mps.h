@@ -28,7 +28,9 @@
  * the particle fields gradPx, gradPy (gradPz), so a restart is exact.
  *
  * Walls are one layer of wall particles (pressure solved) with dummy layers behind them (PND
- * only).  Wall and dummy particles move with the velocity of their patch (movingWalls).
+ * only).  Wall and dummy particles move with the velocity of their patch (movingWalls), or,
+ * on a patch with patch_moved set, with the velocity a model gave them before the step
+ * (elasticWall: mps/elastic_wall.h).
  *
  * Configuration comes from system/schemes.yaml, system/solution.yaml, constant/models.yaml
  * and constant/transportProperties.yaml (lub_mps_config_read); the state is a lub_particles
@@ -74,6 +76,8 @@ typedef struct {
     double g[3];
     int viscosity; /* LUB_VISCOSITY_* */
     double patch_velocity[LUB_MAX_PATCHES][3];
+    int patch_moved[LUB_MAX_PATCHES]; /* 1: a model sets the velocity of the patch's wall and
+                                         dummy particles before each step (elasticWall) */
     int collision;
     double collision_distance; /* in l0 */
     double restitution;

@@ -550,9 +550,9 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
         lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
         rebuild = 1;
     }
-    /* walls and dummies move with their patch velocity */
+    /* walls and dummies move with their patch velocity (unless a model set it: patch_moved) */
     for (size_t i = 0; i < n; i++)
-        if (P->kind[i] != LUB_FLUID)
+        if (P->kind[i] != LUB_FLUID && !m->c.patch_moved[P->patch[i]])
             for (int d = 0; d < dim; d++) P->u[d][i] = m->c.patch_velocity[P->patch[i]][d];
     neighbours(m, rebuild);
 

@@ -101,6 +101,25 @@ static void print_header(const lubfoam_run *r)
                 : m->c.viscosity == LUB_VISCOSITY_EXPLICIT ? "explicit"
                                                            : "crankNicolson");
     lub_message("Solvers: p %s; U %s", ps, vs);
+    if (r->has_elastic) {
+        const lub_mps_elastic *w = &r->elastic;
+        lub_message("elasticWall: patch %s (%d wall, %d dummy particles), E %g Pa, load %g N/m "
+                    "over rampTime %g s, b %g m, p_H %g Pa, mean of %ld steps, load balance "
+                    "alpha %g (at most %g m per step), clamp %g; h0 %.6g m, %ld samples",
+                    w->e.patch_name, w->nw, w->nd, w->e.E, w->e.load, w->e.ramp_time, w->e.b,
+                    w->e.p_hertz, w->e.average_steps, w->e.relaxation, w->e.relaxation * w->e.h0,
+                    w->e.clamp, w->h0, w->samples);
+    }
+}
+
+/* The elastic wall's load error and position, for the log. */
+static void elastic_summary(const lubfoam_run *r, char *buf, size_t size)
+{
+    buf[0] = '\0';
+    if (!r->has_elastic) return;
+    const lub_mps_elastic *w = &r->elastic;
+    snprintf(buf, size, "  load %.4g/%.4g N/m (%+.2f%%) h0 %.5g m", w->load, w->load_target,
+             100.0 * lub_mps_elastic_beta(w), w->h0);
 }
 
 /* Viscosity iterations of the last step: the sum over the velocity components (0 when the
@@ -117,13 +136,14 @@ static void log_line(const lubfoam_run *r, long steps_done, double wall0, double
     const lub_mps *m = &r->mps;
     double frac = fraction_done(r, steps_done);
     double el = lub_wtime() - wall0;
-    char eta[32];
+    char eta[32], ew[128];
     format_hms(frac > 0 ? el * (1 - frac) / frac : NAN, eta, sizeof eta);
+    elastic_summary(r, ew, sizeof ew);
     lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g p %3d it %8.2e (mean %.1f)  "
-                "U %3d it  surf %-6zu ETA %s",
+                "U %3d it  surf %-6zu ETA %s%s",
                 r->t, 100 * frac, r->step, r->dt, m->st.umax * r->dt / m->l0, m->st.p.iterations,
                 m->st.p.residual, steps_done ? pit_sum / (double)steps_done : 0.0,
-                viscosity_iterations(m), m->st.nsurface, eta);
+                viscosity_iterations(m), m->st.nsurface, eta, ew);
 }
 
 static void progress_bar(const lubfoam_run *r, long steps_done, double wall0)
@@ -216,6 +236,7 @@ int main(int argc, char **argv)
     lub_mps_config cfg;
     lub_mps_config_read(&cfg, r.cs.root, &r.P);
     lub_mps_init(&r.mps, &r.P, &cfg, geo.dmin, geo.dmax, geo.periodic);
+    lubfoam_read_elastic(&r, &geo);
     lub_geometry_free(&geo);
     lubfoam_functions *fos = lubfoam_functions_read(&r);
     lub_dict_finish(r.ctl.dict);
@@ -228,7 +249,7 @@ int main(int argc, char **argv)
     const int tty = isatty(STDOUT_FILENO);
     const double wall0 = lub_wtime();
     const long step0 = r.step;
-    long steps = 0;
+    long steps = 0, last_write_step = -1;
     double pit_sum = 0, vit_sum = 0, last_bar = 0;
     int warned_courant = 0, status = LUB_EXIT_OK;
 
@@ -239,9 +260,24 @@ int main(int argc, char **argv)
         }
         if (r.ctl.stop_at == LUB_STOP_ENDTIME && r.t + r.dt > r.ctl.end_time)
             r.dt = r.ctl.end_time - r.t; /* land on endTime exactly */
-        long bad;
+        long bad = -1;
         char msg[1024];
-        lub_step_status s = lub_mps_step(&r.mps, r.dt, &bad, msg, sizeof msg);
+        lub_step_status s = LUB_STEP_OK;
+        if (r.has_elastic) {
+            s = lub_mps_elastic_before(&r.elastic, &r.mps, r.t, r.dt, msg, sizeof msg);
+            if (s != LUB_STEP_OK) {
+                /* nothing has moved: the current state is good, keep it (unless it is the
+                 * start folder or was just written) */
+                if (tty) fputc('\n', stdout);
+                if (steps > 0 && r.step != last_write_step) {
+                    lub_timer_start(&r.mps.tm, LUB_T_OUTPUT);
+                    lubfoam_write(&r);
+                    lubfoam_functions_write(fos, &r);
+                    lub_timer_stop(&r.mps.tm, LUB_T_OUTPUT);
+                }
+            }
+        }
+        if (s == LUB_STEP_OK) s = lub_mps_step(&r.mps, r.dt, &bad, msg, sizeof msg);
         if (s != LUB_STEP_OK) {
             if (tty) fputc('\n', stdout);
             fflush(stdout);
@@ -254,6 +290,7 @@ int main(int argc, char **argv)
         r.t += r.dt;
         r.step++;
         steps++;
+        if (r.has_elastic) lub_mps_elastic_after(&r.elastic, &r.mps, r.t);
         pit_sum += r.mps.st.p.iterations;
         vit_sum += viscosity_iterations(&r.mps);
         double co = r.mps.st.umax * r.dt / r.mps.l0;
@@ -269,6 +306,7 @@ int main(int argc, char **argv)
             lub_timer_start(&r.mps.tm, LUB_T_OUTPUT);
             lubfoam_write(&r);
             lubfoam_functions_write(fos, &r);
+            last_write_step = r.step;
             lub_mps_rebuild_lists(&r.mps); /* exact restart from this folder */
             lub_timer_stop(&r.mps.tm, LUB_T_OUTPUT);
         }
@@ -286,7 +324,15 @@ int main(int argc, char **argv)
     }
     if (tty) fputc('\n', stdout);
     write_cost(&r, steps, lub_wtime() - wall0, pit_sum, vit_sum);
+    if (r.has_elastic) {
+        const lub_mps_elastic *w = &r.elastic;
+        lub_message("elasticWall: t %.9g s: mean load %.6g N/m of %.6g (%+.3f%%), h0 %.9g m, "
+                    "centre %.9g m, v in [%.6g, %.6g] m, closest approach %.6g m",
+                    r.t, w->load, w->load_target, 100.0 * lub_mps_elastic_beta(w), w->h0, w->centre,
+                    w->vmin, w->vmax, w->gap_min);
+    }
     lubfoam_functions_free(fos);
+    lub_mps_elastic_free(&r.elastic);
     lub_mps_free(&r.mps);
     lub_particles_free(&r.P);
     lub_control_free(&r.ctl);

@@ -4,8 +4,10 @@
 
 #include <stdio.h>
 
+#include "geometry/geometry.h"
 #include "io/case.h"
 #include "io/control.h"
+#include "mps/elastic_wall.h"
 #include "mps/mps.h"
 
 /* Run state the writers need. */
@@ -14,6 +16,8 @@ typedef struct {
     lub_control ctl;
     lub_mps mps;
     lub_particles P;
+    int has_elastic;         /* constant/models.yaml has elasticWall */
+    lub_mps_elastic elastic; /* its state */
     double t, dt;
     long step;
     double start_time;
@@ -25,6 +29,9 @@ typedef struct {
 
 /* Start time folder per controlDict (startFrom), reading particles and uniform/state.yaml. */
 void lubfoam_read_start(lubfoam_run *r);
+/* The elasticWall model of constant/models.yaml, if any (after lub_mps_init): its restart
+ * state from the start folder's uniform/state.yaml, the ramp checked against endTime. */
+void lubfoam_read_elastic(lubfoam_run *r, const lub_geometry *geo);
 /* Write the current state as a time folder (atomic), update particles.xdmf, purge. */
 void lubfoam_write(lubfoam_run *r);
 

@@ -1,4 +1,4 @@
-/* lubFoam: start time, restart state and time folders. */
+/* lubFoam: start time, restart state (the elastic wall's too) and time folders. */
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
@@ -55,11 +55,23 @@ void lubfoam_read_start(lubfoam_run *r)
         r->t = lub_dict_real(root, "time", LUB_NONNEGATIVE);
         r->step = lub_dict_int(root, "step", 0, 1L << 62);
         double dt = lub_dict_real_or(root, "deltaT", c->delta_t, LUB_POSITIVE);
+        lub_dict_find(root, "elasticWall"); /* read by lub_mps_elastic_init */
         if (c->adjust_time_step) r->dt = dt < c->delta_t ? dt : c->delta_t;
         lub_dict_finish(st);
         lub_dict_free(st);
     }
     r->start_time = r->t;
+}
+
+void lubfoam_read_elastic(lubfoam_run *r, const lub_geometry *geo)
+{
+    char models[LUB_PATH_MAX], state[LUB_PATH_MAX], what[128];
+    lub_case_path(&r->cs, models, "constant/models.yaml");
+    lub_case_pathf(&r->cs, state, "%s/uniform/state.yaml", r->start_name);
+    int endtime = r->ctl.stop_at == LUB_STOP_ENDTIME;
+    snprintf(what, sizeof what, "endTime %g of system/controlDict.yaml", r->ctl.end_time);
+    r->has_elastic = lub_mps_elastic_init(&r->elastic, &r->mps, geo, models, state,
+                                          endtime ? r->ctl.end_time : 0.0, what);
 }
 
 static void write_state(const lubfoam_run *r, const char *dir)
@@ -74,6 +86,7 @@ static void write_state(const lubfoam_run *r, const char *dir)
     fprintf(fp, "time:   %.17g\n", r->t);
     fprintf(fp, "step:   %ld\n", r->step);
     fprintf(fp, "deltaT: %.17g\n", r->dt);
+    if (r->has_elastic) lub_mps_elastic_write_state(&r->elastic, fp);
     if (fclose(fp) != 0) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
 }
 

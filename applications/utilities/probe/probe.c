@@ -51,10 +51,24 @@ static const char *description =
     "      by the sign of the mean fluid x-velocity) and the outlet meniscus (downstream\n"
     "      edge of that contact run): to a bin width, and to l0/slope with the wall's slope\n"
     "      there (particle rows are l0 apart, so a surface within 2 l0 of the wall is full).\n"
-    "  totals\n"
+    "  totals [-patch NAME]\n"
     "      per time: '# t mass momentumX momentumY momentumZ kineticEnergy fluidParticles'\n"
     "      over the fluid particles, particle mass rho l0^d (per unit depth in 2-D; rho from\n"
-    "      constant/transportProperties.yaml).\n"
+    "      constant/transportProperties.yaml).  With -patch, the load on that wall patch, the\n"
+    "      integral of p dx over its wall particles sorted by x (each owns the half-way\n"
+    "      intervals to its neighbours), as column 'load'; when the patch is the elasticWall\n"
+    "      patch of constant/models.yaml also 'loadMean', the same integral of the running mean\n"
+    "      pWallMean that the load balance uses (0 in a file without it: the mean starts at 0).\n"
+    "  wallShape -patch NAME [-from A -to B]\n"
+    "      the elastic wall (elasticWall in constant/models.yaml, on patch NAME): per wall\n"
+    "      particle, sorted by x: '# x y v h'.  v = y - y_f - h0 - s is the elastic displacement\n"
+    "      (T-50: y = y_f + h0 + s + v, y_f the surface beneath the cylinder's lowest point, h0\n"
+    "      the rigid-body position of the time folder's uniform/state.yaml, s the undeformed\n"
+    "      shape, the particle field elasticShape: the circle, which T-50's (x - x_c)^2/(2R)\n"
+    "      approximates); h = y - (the surface beneath at x), the film thickness that\n"
+    "      reynoldsRef's h describes.  A comment line gives h0.  A particleGen file (no state)\n"
+    "      uses the elasticWall h0 and the circle: v = 0.  -dimensionless adds X = x/b and\n"
+    "      H = h R/b^2 (T-54..T-58); -average the mean per particle over the times.\n"
     "\n"
     "Fields (-field, comma-separated): p, U (columns Ux Uy [Uz]), Ux, Uy, Uz, and the\n"
     "optional fields of the particle files (pMean, pnd ...); default p.\n"
@@ -92,6 +106,8 @@ static const char *description =
     "  probe points -field p,U -at '0 2e-5; 1e-4 2e-5' -time 0.01:0.02\n"
     "  probe film -bin 2e-5 -latestTime\n"
     "  probe totals -o totals.dat\n"
+    "  probe totals -patch cylinder              (load history of the elastic wall)\n"
+    "  probe wallShape -patch cylinder -latestTime -dimensionless\n"
     "  probe -set pWall -latestTime\n"
     "\n"
     "Errors (exit 1): an unknown subcommand, patch (the patches are listed) or field (the\n"
@@ -106,7 +122,7 @@ static const char *const opt_names[O_N] = {"-patch", "-field", "-from", "-to",
 static const int applies[PROBE_NKINDS][O_N] = {
     [PROBE_WALL] = {1, 1, 1, 1, 1, 1, 0, 1},   [PROBE_LINE] = {0, 1, 1, 1, 1, 0, 0, 1},
     [PROBE_POINTS] = {0, 1, 0, 0, 0, 0, 1, 1}, [PROBE_FILM] = {0, 0, 1, 1, 1, 0, 0, 1},
-    [PROBE_TOTALS] = {0, 0, 0, 0, 0, 0, 0, 0},
+    [PROBE_TOTALS] = {1, 0, 0, 0, 0, 0, 0, 0}, [PROBE_SHAPE] = {1, 0, 1, 1, 0, 0, 0, 1},
 };
 
 static const char *in_case(const lub_case *c, const char *path, char *buf)
@@ -123,7 +139,7 @@ static probe_kind find_kind(const char *name)
     char hint[64] = "";
     if (near) snprintf(hint, sizeof hint, " (did you mean '%s'?)", near);
     lub_fatal("unknown subcommand '%s'%s; the subcommands are: wallPressure line points film "
-              "totals (or none: the sets of system/probeDict.yaml); see probe -help",
+              "totals wallShape (or none: the sets of system/probeDict.yaml); see probe -help",
               name, hint);
 }
 
@@ -134,7 +150,8 @@ int main(int argc, char **argv)
     static int arc = 0, dimensionless = 0;
     static lub_strlist set_names = {0};
     lub_option opts[] = {
-        {"-patch", "NAME", "wallPressure: the wall patch", LUB_OPT_STR, &patch},
+        {"-patch", "NAME", "wallPressure, wallShape: the wall patch; totals: add its load",
+         LUB_OPT_STR, &patch},
         {"-field", "LIST", "fields, e.g. p or p,U or pMean (default p)", LUB_OPT_STR, &field},
         {"-from", "X0", "start of the x-range (with -arc: of s)", LUB_OPT_REAL, &from},
         {"-to", "X1", "end of the x-range", LUB_OPT_REAL, &to},
@@ -152,11 +169,13 @@ int main(int argc, char **argv)
     lub_program_info info = {
         .name = "probe",
         .summary = "sample particle fields of the time folders: wall pressure, lines, points, "
-                   "film, totals",
+                   "film, totals, the elastic wall's shape",
         .usage = "[SUBCOMMAND] [OPTIONS]",
         .description = description,
         .dictionaries = "system/probeDict.yaml (without a subcommand, or with -set)\n"
-                        "system/particleGenDict.yaml (default x-range; -arc)\n"
+                        "system/particleGenDict.yaml (default x-range; -arc; wallShape)\n"
+                        "constant/models.yaml (wallShape, totals -patch: elasticWall)\n"
+                        "<time>/uniform/state.yaml (wallShape: h0)\n"
                         "constant/transportProperties.yaml (totals: rho; -dimensionless)\n"
                         "system/reynoldsRefDict.yaml, constant/models.yaml (-dimensionless)",
         .time_selection = 1,
@@ -193,8 +212,9 @@ int main(int argc, char **argv)
             if (given[o] && !applies[kind][o])
                 lub_fatal("option '%s' does not apply to '%s'; see probe -help", opt_names[o],
                           probe_kind_names[kind]);
-        if (kind == PROBE_WALL && !patch)
-            lub_fatal("wallPressure needs -patch NAME (a wall of the case, e.g. -patch cylinder)");
+        if ((kind == PROBE_WALL || kind == PROBE_SHAPE) && !patch)
+            lub_fatal("%s needs -patch NAME (a wall of the case, e.g. -patch cylinder)",
+                      probe_kind_names[kind]);
         if (kind == PROBE_POINTS && !at)
             lub_fatal("points needs -at 'x y; x y ...' (the points to sample)");
         probe_spec s;

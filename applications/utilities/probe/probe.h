@@ -15,6 +15,7 @@
 #include "io/case.h"
 #include "io/dict.h"
 #include "io/table.h"
+#include "models/elastic.h"
 #include "reynolds/refcase.h"
 
 typedef enum {
@@ -23,6 +24,7 @@ typedef enum {
     PROBE_POINTS,
     PROBE_FILM,
     PROBE_TOTALS,
+    PROBE_SHAPE,
     PROBE_NKINDS
 } probe_kind;
 
@@ -32,7 +34,7 @@ extern const char *const probe_kind_names[]; /* "wallPressure", ..., NULL */
 typedef struct {
     probe_kind kind;
     char name[64];     /* set name (file name of its output), or the subcommand */
-    const char *patch; /* wallPressure */
+    const char *patch; /* wallPressure, wallShape; totals: the load on this patch */
     char fields[1024]; /* comma-separated field list (default "p") */
     double from, to, bin;
     int arc;     /* wallPressure: against arc length */
@@ -103,6 +105,9 @@ typedef struct {
     lub_geometry geom;
     int have_rho;
     double rho;
+    int ew_state;     /* constant/models.yaml elasticWall: 0 not read, 1 read, -1 none */
+    lub_dict *models; /* owns ew's nodes */
+    lub_elastic_wall ew;
 } probe_ctx;
 
 void probe_ctx_free(probe_ctx *x);

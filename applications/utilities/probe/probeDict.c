@@ -4,7 +4,8 @@
  *     pFilm:  { type: line, field: p, from: -0.004, to: 0.003, bin: 2.5e-5 }
  *     probes: { type: points, field: [p, U], at: [[0, 2.0e-5], [1.0e-4, 2.0e-5]] }
  *     film:   { type: film, bin: 2.0e-5 }
- *     totals: { type: totals }
+ *     totals: { type: totals }                            # patch: adds its load
+ *     shape:  { type: wallShape, patch: cylinder }        # the elastic wall's deformation
  *
  * Template with every key: etc/templates/probeDict.yaml.
  */
@@ -17,7 +18,8 @@
 #include "core/error.h"
 #include "probe.h"
 
-const char *const probe_kind_names[] = {"wallPressure", "line", "points", "film", "totals", NULL};
+const char *const probe_kind_names[] = {"wallPressure", "line",      "points", "film",
+                                        "totals",       "wallShape", NULL};
 
 void probe_spec_init(probe_spec *s, probe_kind kind, const char *name)
 {
@@ -191,16 +193,20 @@ static void read_set(probe_spec *s, const char *name, lub_node *m)
     probe_kind kind = (probe_kind)lub_dict_choice(m, "type", probe_kind_names, -1);
     probe_spec_init(s, kind, name);
     s->node = m;
-    if (kind == PROBE_WALL) {
+    if (kind == PROBE_WALL || kind == PROBE_SHAPE) {
         s->patch_node = lub_dict_get(m, "patch");
         s->patch = lub_dict_str(m, "patch");
-        s->arc = lub_dict_bool_or(m, "arc", 0);
     }
+    if (kind == PROBE_TOTALS) {
+        s->patch_node = lub_dict_find(m, "patch");
+        s->patch = s->patch_node ? lub_dict_str(m, "patch") : NULL;
+    }
+    if (kind == PROBE_WALL) s->arc = lub_dict_bool_or(m, "arc", 0);
     if (kind == PROBE_WALL || kind == PROBE_LINE || kind == PROBE_POINTS) read_fields(s, m);
-    if (kind == PROBE_WALL || kind == PROBE_LINE || kind == PROBE_FILM) {
+    if (kind == PROBE_WALL || kind == PROBE_LINE || kind == PROBE_FILM || kind == PROBE_SHAPE) {
         s->from = lub_dict_real_or(m, "from", NAN, LUB_ANY);
         s->to = lub_dict_real_or(m, "to", NAN, LUB_ANY);
-        s->bin = lub_dict_real_or(m, "bin", NAN, LUB_POSITIVE);
+        if (kind != PROBE_SHAPE) s->bin = lub_dict_real_or(m, "bin", NAN, LUB_POSITIVE);
         if (!isnan(s->from) && !isnan(s->to) && !(s->from < s->to))
             lub_node_error(lub_dict_get(m, "to"), "'to' (%g) must be greater than 'from' (%g)",
                            s->to, s->from);
@@ -228,7 +234,8 @@ void probe_sets_read(probe_sets *S, const lub_case *c)
     S->dict = lub_dict_read_optional(lub_case_path(c, path, DICT));
     if (!S->dict)
         lub_fatal("no subcommand given and no %s in case '%s': give a subcommand (wallPressure, "
-                  "line, points, film, totals) or write the dictionary; see probe -help",
+                  "line, points, film, totals, wallShape) or write the dictionary; see probe "
+                  "-help",
                   DICT, c->root);
     lub_node *root = lub_dict_root(S->dict);
     size_t n = lub_node_size(root);

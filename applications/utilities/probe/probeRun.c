@@ -13,14 +13,19 @@
 #include "core/error.h"
 #include "io/particles_io.h"
 #include "models/transport.h"
+#include "models/models.h"
 #include "post/film.h"
 #include "post/sample.h"
+#include "post/wallshape.h"
 #include "probe.h"
 
 void probe_ctx_free(probe_ctx *x)
 {
     if (x->geom_state > 0) lub_geometry_free(&x->geom);
     x->geom_state = 0;
+    lub_dict_free(x->models);
+    x->models = NULL;
+    x->ew_state = 0;
 }
 
 /* ---- the case's dictionaries, read when a set needs them ------------------------------ */
@@ -60,6 +65,26 @@ static const lub_refscales *ctx_scales(probe_ctx *x)
         x->have_scales = 1;
     }
     return &x->scales;
+}
+
+/* The elasticWall entry of constant/models.yaml (read against the geometry), or NULL when
+ * the case has none. */
+static const lub_elastic_wall *ctx_elastic(probe_ctx *x)
+{
+    if (x->ew_state == 0) {
+        char path[LUB_PATH_MAX];
+        struct stat st;
+        x->ew_state = -1;
+        if (stat(lub_case_path(&x->c, path, "constant/models.yaml"), &st) == 0 &&
+            ctx_geometry(x, NULL)) {
+            x->models = lub_dict_read(path);
+            lub_node *root = lub_dict_root(x->models);
+            lub_models_declare(root);
+            if (lub_elastic_wall_read(root, &x->geom, &x->ew)) x->ew_state = 1;
+            lub_dict_finish(x->models);
+        }
+    }
+    return x->ew_state > 0 ? &x->ew : NULL;
 }
 
 static double ctx_rho(probe_ctx *x)
@@ -639,36 +664,177 @@ static void run_film(job *j)
     lub_accum_free(&acc);
 }
 
+/* ---- wallShape: the elastic wall's deformation ---------------------------------------- */
+
+/* The elastic wall of the set's patch; fatal when the case has none on it. */
+static const lub_elastic_wall *job_elastic(job *j, const char *what)
+{
+    const probe_spec *s = j->s;
+    ctx_geometry(j->x, what);
+    const lub_elastic_wall *e = ctx_elastic(j->x);
+    if (!e)
+        probe_error(s->node,
+                    "%s needs the elasticWall model in constant/models.yaml of case '%s' "
+                    "(template: etc/templates/models.yaml)",
+                    what, j->x->c.root);
+    if (strcmp(e->patch_name, s->patch) != 0)
+        probe_error(s->patch_node,
+                    "%spatch '%s' is not the elastic wall: elasticWall in constant/models.yaml "
+                    "names '%s'",
+                    s->patch_node ? "" : "-patch: ", s->patch, e->patch_name);
+    return e;
+}
+
+/* h0 of time folder `it`: its uniform/state.yaml (elasticWall.h0), else the elasticWall h0
+ * (a particleGen folder).  *from names the source. */
+static double job_h0(job *j, size_t it, const lub_elastic_wall *e, const char **from)
+{
+    char path[LUB_PATH_MAX];
+    lub_case_pathf(&j->x->c, path, "%s/uniform/state.yaml", j->times[it].name);
+    lub_dict *d = lub_dict_read_optional(path);
+    lub_node *m = d ? lub_dict_map_or(lub_dict_root(d), "elasticWall") : NULL;
+    double h0 = e->h0;
+    *from = "the elasticWall h0 of constant/models.yaml: no state in this time folder";
+    if (m) {
+        h0 = lub_dict_real(m, "h0", LUB_ANY);
+        *from = "uniform/state.yaml";
+    }
+    lub_dict_free(d);
+    return h0;
+}
+
+static void run_shape(job *j)
+{
+    const probe_spec *s = j->s;
+    const lub_elastic_wall *e = job_elastic(j, "wallShape");
+    enum { X, Y, V, H, NC };
+    id_row *ids = NULL;
+    size_t nids = 0;
+    lub_accum acc = {0};
+    key_row *order = NULL;
+    double h0sum = 0.0;
+    size_t nh0 = 0;
+    const char *h0from = "";
+    for (size_t it = 0; it < j->nt; it++) {
+        job_read(j, it);
+        int patch = job_patch(j);
+        double h0 = job_h0(j, it, e, &h0from);
+        h0sum += h0;
+        nh0++;
+        lub_wall_shape_row *rows;
+        size_t n = lub_wall_shape(&j->P, patch, &j->x->geom, e, h0, &rows);
+        lub_particles_free(&j->P);
+        if (it == 0) {
+            if (n == 0)
+                probe_error(s->patch_node, "%spatch '%s' has no wall particles in %s",
+                            s->patch_node ? "" : "-patch: ", s->patch, j->file);
+            ids = lub_malloc(n * sizeof *ids);
+            for (size_t k = 0; k < n; k++) ids[k] = (id_row){rows[k].id, (int)k};
+            nids = n;
+            qsort(ids, nids, sizeof *ids, id_cmp);
+            lub_accum_init(&acc, (int)nids, NC);
+            order = lub_malloc(nids * sizeof *order);
+        }
+        for (size_t k = 0; k < n; k++) {
+            const lub_wall_shape_row *r = &rows[k];
+            if ((!isnan(s->from) && r->x < s->from) || (!isnan(s->to) && r->x > s->to)) continue;
+            id_row key = {r->id, 0}, *hit = bsearch(&key, ids, nids, sizeof *ids, id_cmp);
+            if (!hit)
+                lub_fatal("%s: wall particle %llu of patch '%s' is not in the first time folder "
+                          "(%s)",
+                          j->file, (unsigned long long)r->id, s->patch, j->times[0].name);
+            double v[NC] = {r->x, r->y, r->v, r->h};
+            lub_accum_add(&acc, hit->row, v);
+        }
+        free(rows);
+        if (s->average && it != j->nt - 1) continue;
+
+        char h[256] = "x[m] y[m] v[m] h[m]";
+        if (j->sc) header_add(h, sizeof h, "X H");
+        probe_block_begin(&j->b, h, NC + (j->sc ? 2 : 0));
+        size_t nrow = 0;
+        for (size_t r = 0; r < nids; r++)
+            if (acc.count[r] > 0.0)
+                order[nrow++] = (key_row){lub_accum_mean(&acc, (int)r, X), (int)r};
+        qsort(order, nrow, sizeof *order, key_cmp);
+        for (size_t q = 0; q < nrow; q++) {
+            int r = order[q].row;
+            double row[NC + 2];
+            for (int c = 0; c < NC; c++) row[c] = lub_accum_mean(&acc, r, c);
+            if (j->sc) {
+                row[NC] = row[X] / j->sc->sx;
+                row[NC + 1] = row[H] / j->sc->h0;
+            }
+            probe_block_row(&j->b, row);
+        }
+        if (nh0 == 1)
+            probe_block_comment(&j->b, "h0 = %.17g m (%s)", h0sum, h0from);
+        else
+            probe_block_comment(&j->b, "h0 = %.17g m (mean over %zu times)", h0sum / (double)nh0,
+                                nh0);
+        job_emit(j, it);
+        lub_accum_clear(&acc);
+        h0sum = 0.0;
+        nh0 = 0;
+    }
+    free(ids);
+    free(order);
+    lub_accum_free(&acc);
+}
+
 /* ---- totals: one row per time --------------------------------------------------------- */
 
 static void run_totals(job *j)
 {
     double rho = ctx_rho(j->x);
-    enum { NC = 7 };
+    enum { NFIX = 7, NC = 9 };
     double sum[NC] = {0};
-    int dim = 2;
+    int dim = 2, nc = NFIX;
+    /* -patch: the load on the patch; loadMean when it is the elastic wall */
+    const lub_elastic_wall *e = j->s->patch ? ctx_elastic(j->x) : NULL;
+    int mean = e && strcmp(e->patch_name, j->s->patch) == 0;
+    if (j->s->patch) nc += 1 + mean;
     for (size_t it = 0; it < j->nt; it++) {
         job_read(j, it);
         dim = j->P.dim;
         lub_totals t;
         lub_totals_compute(&t, &j->P, rho);
-        lub_particles_free(&j->P);
         double row[NC] = {j->times[it].value, t.mass,    t.momentum[0],   t.momentum[1],
                           t.momentum[2],      t.kinetic, (double)t.nfluid};
-        if (it == 0)
-            probe_block_begin(&j->b,
-                              dim == 2 ? "t[s] mass[kg/m] momentumX[kg/s] momentumY[kg/s] "
-                                         "momentumZ[kg/s] kineticEnergy[J/m] fluidParticles"
-                                       : "t[s] mass[kg] momentumX[kg*m/s] momentumY[kg*m/s] "
-                                         "momentumZ[kg*m/s] kineticEnergy[J] fluidParticles",
-                              NC);
+        if (j->s->patch) {
+            int patch = job_patch(j);
+            if (dim != 2)
+                probe_error(j->s->patch_node,
+                            "%sthe load on a patch (the integral of p dx along it) is 2-D only; "
+                            "%s is %d-D",
+                            j->s->patch_node ? "" : "totals -patch: ", j->file, dim);
+            if (lub_wall_integral(&j->P, patch, j->P.p, &row[NFIX]) != 0)
+                probe_error(j->s->patch_node,
+                            "%spatch '%s' is not a curve y(x) in %s (two wall particles share "
+                            "an x), so its load (the integral of p dx) is not defined",
+                            j->s->patch_node ? "" : "-patch: ", j->s->patch, j->file);
+            const double *pm = lub_particles_find_extra(&j->P, LUB_ELASTIC_FIELD_MEAN);
+            row[NFIX + 1] = 0.0;
+            if (mean && pm) lub_wall_integral(&j->P, patch, pm, &row[NFIX + 1]);
+        }
+        lub_particles_free(&j->P);
+        if (it == 0) {
+            char h[512];
+            snprintf(h, sizeof h, "%s%s%s",
+                     dim == 2 ? "t[s] mass[kg/m] momentumX[kg/s] momentumY[kg/s] "
+                                "momentumZ[kg/s] kineticEnergy[J/m] fluidParticles"
+                              : "t[s] mass[kg] momentumX[kg*m/s] momentumY[kg*m/s] "
+                                "momentumZ[kg*m/s] kineticEnergy[J] fluidParticles",
+                     j->s->patch ? " load[N/m]" : "", mean ? " loadMean[N/m]" : "");
+            probe_block_begin(&j->b, h, nc);
+        }
         if (j->s->average)
-            for (int c = 0; c < NC; c++) sum[c] += row[c];
+            for (int c = 0; c < nc; c++) sum[c] += row[c];
         else
             probe_block_row(&j->b, row);
     }
     if (j->s->average) {
-        for (int c = 0; c < NC; c++) sum[c] /= (double)j->nt;
+        for (int c = 0; c < nc; c++) sum[c] /= (double)j->nt;
         probe_block_row(&j->b, sum);
         probe_block_comment(&j->b, "mean over the %zu time folders %s .. %s", j->nt,
                             j->times[0].name, j->times[j->nt - 1].name);
@@ -712,6 +878,9 @@ void probe_run(probe_ctx *x, probe_spec *s, probe_sink *k)
         break;
     case PROBE_TOTALS:
         run_totals(&j);
+        break;
+    case PROBE_SHAPE:
+        run_shape(&j);
         break;
     default:
         lub_bug("kind %d", (int)s->kind);

@@ -1,0 +1,54 @@
+/* lubkit post-processing: the wall particles of one patch as a curve y(x), its load and the
+ * elastic wall's deformation (probe wallShape, probe totals -patch).
+ *
+ * A 2-D wall patch that is a graph y(x) (a cylinder's lower arc, a plane) carries the
+ * vertical load per unit length
+ *
+ *     L = integral of p dx = sum_k p_k w_k
+ *
+ * over its wall particles sorted by x, w_k the segment widths of lub_elastic_segment_widths
+ * (half-way to each neighbour), exactly the sum the elasticWall model balances against its
+ * load (mps/elastic_wall.h).
+ *
+ * The elastic wall (models/elastic.h, mps/elastic_wall.h) puts wall particle k at
+ *
+ *     y_k = y_f + h0 + s_k + v_k                                                    (T-50)
+ *
+ * y_f the surface beneath the cylinder's lowest point (lub_elastic_floor), h0 the rigid-body
+ * position (uniform/state.yaml of the time folder), s_k the undeformed shape (the particle
+ * field elasticShape that the solver writes; in a file without it, a particleGen file, the
+ * circle of the geometry: s = R - sqrt(R^2 - (x - x_c)^2), which T-50's (x - x_c)^2/(2R)
+ * approximates to (x - x_c)^4/(8R^3)) and v_k the elastic displacement.  lub_wall_shape
+ * returns x, y, v = y - y_f - h0 - s, and the film thickness h = y - (the surface beneath at
+ * x), the gap that reynoldsRef's h(x) describes.
+ */
+#ifndef LUB_POST_WALLSHAPE_H
+#define LUB_POST_WALLSHAPE_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "geometry/geometry.h"
+#include "models/elastic.h"
+#include "particles/particles.h"
+
+/* The wall particles (kind wall) of patch, sorted by x (ties by id): their indices into
+ * *idx (allocated; free it).  Returns the count. */
+size_t lub_wall_curve(const lub_particles *P, int patch, size_t **idx);
+
+/* sum_k f_k w_k over the wall particles of patch (see above) into *out.  Returns 0, or -1
+ * when two of them share an x (the patch is not a graph y(x)); *out = 0 without particles. */
+int lub_wall_integral(const lub_particles *P, int patch, const double *f, double *out);
+
+typedef struct {
+    double x, y, v, h; /* see above */
+    uint64_t id;
+} lub_wall_shape_row;
+
+/* The shape of the elastic wall e (its patch's index in P: patch) at rigid-body position
+ * h0, one row per wall particle sorted by x, into *rows (allocated; free it); g is the
+ * geometry e was read against.  h is NAN where no surface lies beneath.  Returns the count. */
+size_t lub_wall_shape(const lub_particles *P, int patch, const lub_geometry *g,
+                      const lub_elastic_wall *e, double h0, lub_wall_shape_row **rows);
+
+#endif
