@@ -10,7 +10,14 @@
  * totals.dat:  # t mass momentumX momentumY momentumZ kineticEnergy fluidParticles
  *              (per unit depth in 2-D: particle mass rho l0^d)
  * p.dat:       # x p n   wall pressure of the patch averaged over the window and the bin
- *              (n: samples); rewritten at every write time and at the end.
+ *              (n: samples); rewritten at every write time and at the end, with a second
+ *              line "# samples S steps from t = A to t = B" (the steps averaged so far).
+ *              A run restarted inside the window continues the average: it reads the p.dat
+ *              of an earlier start whose last sample is the step it restarts from (sum =
+ *              p n per bin, exact to round-off) and writes the whole window's mean under its
+ *              own start time.  If no such table exists (the earlier run was stopped between
+ *              writing its time folder and its table, or the table was deleted) it says so
+ *              and averages from its start time only.
  * The cost table (postProcessing/cost/<startTime>/cost.dat) is written by lubFoam itself.
  *
  * With the elasticWall model (constant/models.yaml) a table is always written, every
@@ -23,6 +30,7 @@
  * loadTarget - 1, loadInstant the integral of the wall pressure of the step, v the elastic
  * displacement, gapMin the smallest distance of a wall particle to the surface beneath.
  */
+#include <dirent.h>
 #include <errno.h>
 #include <math.h>
 #include <stdlib.h>
@@ -45,6 +53,8 @@ typedef struct {
     int nbins;
     double *sum;
     long *count;
+    long samples; /* steps averaged */
+    double tfirst, tlast;
 } fo;
 
 struct lubfoam_functions {
@@ -83,6 +93,83 @@ static void elastic_row(lubfoam_functions *F, lubfoam_run *r)
                       w->gap_min};
     lub_table_write_row(F->elastic, row, 11);
     fflush(F->elastic);
+}
+
+/* Samples line of a wallPressure p.dat: 1 and S, A, B if the file has it. */
+static int read_samples_line(const char *path, long *S, double *A, double *B)
+{
+    FILE *fp = fopen(path, "r");
+    if (!fp) return 0;
+    char line[512];
+    int found = 0;
+    while (fgets(line, sizeof line, fp) && line[0] == '#')
+        if (sscanf(line, "# samples %ld steps from t = %lg to t = %lg", S, A, B) == 3) {
+            found = 1;
+            break;
+        }
+    fclose(fp);
+    return found;
+}
+
+/* A run that starts inside the averaging window of o continues the average of the earlier
+ * run it restarts from: the p.dat of the latest earlier start time whose last sample is the
+ * start step (see the header). */
+static void wall_pressure_resume(fo *o, lubfoam_run *r)
+{
+    double eps = 0.5 * r->dt + 1e-12 * fabs(r->t);
+    if (!(r->t > o->t0 + eps) || !(o->t0 < o->t1)) return;
+    char dir[LUB_PATH_MAX];
+    lub_case_pathf(&r->cs, dir, "postProcessing/%s", o->name);
+    DIR *dp = opendir(dir);
+    if (!dp) return;
+    double best_t = -INFINITY;
+    char best[LUB_PATH_MAX] = "";
+    long bestS = 0;
+    double bestA = 0;
+    struct dirent *de;
+    while ((de = readdir(dp))) {
+        char *end;
+        double tv = strtod(de->d_name, &end);
+        if (end == de->d_name || *end || !(tv < r->t + eps) || !(tv > best_t)) continue;
+        char path[LUB_PATH_MAX];
+        long S;
+        double A, B;
+        if (snprintf(path, sizeof path, "%s/%s/p.dat", dir, de->d_name) >= (int)sizeof path)
+            continue;
+        if (!read_samples_line(path, &S, &A, &B) || fabs(B - r->t) > eps) continue;
+        best_t = tv;
+        bestS = S;
+        bestA = A;
+        snprintf(best, sizeof best, "%s", path);
+    }
+    closedir(dp);
+    if (!best[0]) {
+        lub_warning("function '%s': no earlier average ending at the start time %g was found "
+                    "under %s: the wall pressure is averaged from t = %g on, not from "
+                    "timeStart %g",
+                    o->name, r->t, dir, r->t, o->t0);
+        return;
+    }
+    lub_table t;
+    lub_table_read(&t, best);
+    int cx = lub_table_col(&t, "x"), cp = lub_table_col(&t, "p"), cn = lub_table_col(&t, "n");
+    for (size_t k = 0; k < t.nrow; k++) {
+        double b = (lub_table_at(&t, k, (size_t)cx) - o->from) / o->bin - 0.5;
+        int ib = (int)lround(b);
+        if (fabs(b - ib) > 1e-6 || ib < 0 || ib >= o->nbins)
+            lub_fatal_run("function '%s': %s has a bin at x = %g that is not a bin of this "
+                          "run (from %g, bin %g): the bins changed since that run",
+                          o->name, best, lub_table_at(&t, k, (size_t)cx), o->from, o->bin);
+        long n = lround(lub_table_at(&t, k, (size_t)cn));
+        o->count[ib] += n;
+        o->sum[ib] += lub_table_at(&t, k, (size_t)cp) * (double)n;
+    }
+    lub_table_free(&t);
+    o->samples = bestS;
+    o->tfirst = bestA;
+    o->tlast = r->t;
+    lub_message("function '%s': continues the average of %s (%ld steps from t = %g)", o->name,
+                best, bestS, bestA);
 }
 
 lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
@@ -132,6 +219,7 @@ lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
                 lub_node_error(d, "function '%s': %d bins", name, o->nbins);
             o->sum = lub_calloc((size_t)o->nbins, sizeof *o->sum);
             o->count = lub_calloc((size_t)o->nbins, sizeof *o->count);
+            wall_pressure_resume(o, r);
         }
     }
     if (r->has_elastic) {
@@ -173,6 +261,8 @@ static void wall_pressure(fo *o, lubfoam_run *r)
         o->sum[b] += P->p[i];
         o->count[b]++;
     }
+    if (!o->samples++) o->tfirst = r->t;
+    o->tlast = r->t;
 }
 
 void lubfoam_functions_execute(lubfoam_functions *F, lubfoam_run *r)
@@ -199,6 +289,9 @@ void lubfoam_functions_write(lubfoam_functions *F, lubfoam_run *r)
         FILE *fp = lub_atomic_open(&af, path);
         if (!fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
         lub_table_write_header(fp, "x p n");
+        if (o->samples)
+            fprintf(fp, "# samples %ld steps from t = %.17g to t = %.17g\n", o->samples,
+                    o->tfirst, o->tlast);
         for (int b = 0; b < o->nbins; b++) {
             if (!o->count[b]) continue;
             double row[3] = {o->from + (b + 0.5) * o->bin, o->sum[b] / (double)o->count[b],

@@ -19,10 +19,12 @@ set output "ehl.png"
 if (!exists("b")) b = 0.00113809
 if (!exists("pH")) pH = 559373
 ref = "postProcessing/reynoldsRef/0/p.dat"
-pw = "postProcessing/wallPressure/0/p.dat"
+# the table of the latest start time: a restarted run continues the average there
+# (Allrun passes it with -e "pw = '...'")
+if (!exists("pw")) pw = "postProcessing/wallPressure/0/p.dat"
 ws = "postProcessing/probe/wallShape.dat"
 fm = "postProcessing/probe/film.dat"
-ew = "postProcessing/elasticWall/0/elasticWall.dat"
+if (!exists("ew")) ew = "postProcessing/elasticWall/0/elasticWall.dat"
 set multiplot layout 3,1
 set grid
 set key bottom center

@@ -22,7 +22,9 @@ set label "Martin exit (T-37) " at 0.475*sqrt(2), graph 0.92 right tc rgb "gray4
 # reynoldsRef (R = 0.04 m, h0 = 40 um, rho nu = 0.19125 Pa s, U1 = 1.2 m/s)
 sx = 1 / sqrt(0.04 * 4.0e-5)
 sp = (4.0e-5)**1.5 / (850 * 2.25e-4 * 1.2 * sqrt(0.04))
-mps = "postProcessing/wallPressure/0/p.dat"
+# the table of the latest start time: a restarted run continues the average there
+# (Allrun passes it with -e "mps = '...'")
+if (!exists("mps")) mps = "postProcessing/wallPressure/0/p.dat"
 if (system("test -s " . mps . " && echo 1 || echo 0") + 0) {
     plot "postProcessing/reynoldsRef/0/p.dat" using 4:5 with lines lw 2 lc rgb "black" \
          title "Reynolds equation (reynoldsRef)", \
