@@ -5,7 +5,7 @@
  *     effectiveRadius:  3.1          # re / l0 (T-6)
  *     gradient:         lsmps        # standard (T-13) | lsmps (T-15)
  *     minPressureShift: true         # p_hat of T-14 in the gradient
- *     negativePressure: clip         # clip | keep
+ *     negativePressure: clip         # clip | keep | cavitation
  *     dummyVelocity:    mirror       # mirror (no-slip ghost 2 U - u_i) | wall (U)
  *     pressure:         { alpha: 0, gamma: 0.2, predictor: 0.1 }   # T-9; lub_mps_step
  *     freeSurface:      { beta: 0.97, asymmetry: 0.2 }       # T-12 + geometric test
@@ -79,14 +79,14 @@ static void read_linsolver(lub_node *map, lub_linsolver_options *o, int *cont)
 static void read_schemes(lub_mps_config *c, const char *path)
 {
     static const char *const grad[] = {"standard", "lsmps", NULL};
-    static const char *const neg[] = {"keep", "clip", NULL};
+    static const char *const neg[] = {"keep", "clip", "cavitation", NULL};
     static const char *const dummy[] = {"wall", "mirror", NULL};
     lub_dict *d = lub_dict_read(path);
     lub_node *r = lub_dict_root(d);
     c->re_l0 = lub_dict_real_or(r, "effectiveRadius", 3.1, LUB_BETWEEN(1.5, 6.0));
     c->gradient = lub_dict_choice(r, "gradient", grad, LUB_GRADIENT_LSMPS);
     c->min_pressure_shift = lub_dict_bool_or(r, "minPressureShift", 1);
-    c->clip_negative = lub_dict_choice(r, "negativePressure", neg, 1);
+    c->clip_negative = lub_dict_choice(r, "negativePressure", neg, LUB_NEGATIVE_CLIP);
     c->mirror_dummies = lub_dict_choice(r, "dummyVelocity", dummy, c->mirror_dummies);
     lub_node *p = lub_dict_map_or(r, "pressure");
     c->alpha = lub_dict_real_or(p, "alpha", 0.0, LUB_NONNEGATIVE);

@@ -48,13 +48,15 @@
 
 enum { LUB_GRADIENT_STANDARD = 0, LUB_GRADIENT_LSMPS = 1 };
 enum { LUB_VISCOSITY_NONE = 0, LUB_VISCOSITY_EXPLICIT = 1, LUB_VISCOSITY_CN = 2 };
+enum { LUB_NEGATIVE_KEEP = 0, LUB_NEGATIVE_CLIP = 1, LUB_NEGATIVE_CAVITATION = 2 };
 
 typedef struct {
     /* system/schemes.yaml */
     double re_l0;           /* re / l0 (T-6; 3.1) */
     int gradient;           /* LUB_GRADIENT_* */
     int min_pressure_shift; /* p_hat of T-14 */
-    int clip_negative;      /* negative pressure set to 0 after the solve */
+    int clip_negative;      /* LUB_NEGATIVE_*: negative pressure kept, set to 0 after the
+                               solve, or held at 0 by the cavitation condition */
     double alpha, gamma;    /* T-9 */
     double predictor;       /* weight of the newest pressure gradient in the running mean
                                that the viscous predictor feels (0: off; see lub_mps_step) */
@@ -132,6 +134,8 @@ typedef struct {
     double *grad[3];
     double *gbar[3]; /* predictor: running mean of the pressure gradient (particle extra
                         fields gradPx, gradPy, gradPz, so that it is saved and reordered) */
+    double *cav; /* negativePressure cavitation: 1 where the pressure is held at 0 (particle
+                    extra field "cavitation", so that it is saved and reordered), else NULL */
     double *lap;
     void *scratch;
     long steps; /* global step count (from the particle file) */

@@ -56,6 +56,8 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
     static const char *const gbar_names[3] = {"gradPx", "gradPy", "gradPz"};
     for (int d = 0; d < 3; d++)
         m->gbar[d] = c->predictor > 0 && d < m->dim ? lub_particles_extra(P, gbar_names[d]) : NULL;
+    m->cav = c->clip_negative == LUB_NEGATIVE_CAVITATION ? lub_particles_extra(P, "cavitation")
+                                                          : NULL;
     for (int d = 0; d < 3; d++) {
         m->us[d] = alloc_doubles(n);
         m->bv[d] = alloc_doubles(n);
@@ -339,7 +341,20 @@ static void free_surface(lub_mps *m)
 /* Pressure Poisson equation (T-9, T-10), negated so that the matrix is symmetric positive
  * definite: c sum_j w_ij (P_i - P_j) + alpha P_i = gamma rho / dt^2 (n*_i - n0) / n0,
  * c = 2d / (lambda0 n0), over fluid and wall particles; surface particles are Dirichlet
- * (P = 0), dummy particles carry no pressure. */
+ * (P = 0), dummy particles carry no pressure.
+ *
+ * Negative pressure (schemes.yaml negativePressure): `keep`; `clip`, set to 0 after the solve
+ * (the thesis); or `cavitation`, the complementarity condition P >= 0, (A P - b)_i >= 0,
+ * P_i (A P - b)_i = 0 of a liquid that cannot carry tension, which is what the Reynolds
+ * boundary condition (p = dp/dx = 0 at the film's rupture) expresses for a film.  Clipping
+ * after the solve is not that: the solve still pulls the pressure near the rupture down
+ * towards the negative values it finds past it, and the film's pressure falls to zero before
+ * the Reynolds exit.  The condition is met by an active set lagged by one step: a particle
+ * whose solved pressure was negative is held at P = 0 (a Dirichlet particle, like a surface
+ * particle) from the next step on, and released when its row would give it a positive
+ * pressure, b_i + c sum_j w_ij P_j > 0 (the multiplier changes sign).  In a steady flow the
+ * set settles to the complementarity solution; each step costs one solve, as with clip.
+ * The set is the particle field "cavitation" (saved with the particles: exact restart). */
 static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
 {
     lub_particles *P = m->P;
@@ -352,7 +367,7 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
     lub_timer_start(&m->tm, LUB_T_ASSEMBLY);
     int nu = 0;
     for (size_t i = 0; i < n; i++) {
-        int unknown = P->kind[i] != LUB_DUMMY && !m->surface[i];
+        int unknown = P->kind[i] != LUB_DUMMY && !m->surface[i] && !(m->cav && m->cav[i] > 0);
         m->row[i] = unknown ? nu : -1;
         if (unknown) m->prow[nu++] = (int)i;
     }
@@ -409,11 +424,30 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
         }
         return -1;
     }
-    const int clip = m->c.clip_negative;
+    const int clip = m->c.clip_negative != LUB_NEGATIVE_KEEP;
+    double *cav = m->cav;
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         double p = m->row[i] >= 0 ? m->x[m->row[i]] : 0.0;
         P->p[i] = (clip && p < 0) ? 0.0 : p;
+        if (cav && m->row[i] >= 0) cav[i] = p < 0;
+    }
+    if (cav) {
+        /* release the held particles whose row would now give them a positive pressure */
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            if (!(cav[i] > 0)) continue;
+            if (P->kind[i] == LUB_DUMMY || m->surface[i]) {
+                cav[i] = 0;
+                continue;
+            }
+            double f = src * (m->pnd[i] - m->n0);
+            for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+                size_t j = nb->j[q];
+                if (nb->w[q] > 0 && P->kind[j] != LUB_DUMMY) f += c * nb->w[q] * P->p[j];
+            }
+            if (f > 0) cav[i] = 0;
+        }
     }
     return 0;
 }
