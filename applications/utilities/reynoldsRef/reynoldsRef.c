@@ -58,6 +58,7 @@ int main(int argc, char **argv)
 {
     static int dimensionless = 0;
     static const char *out_file = NULL;
+    static double inlet = NAN;
     lub_option opts[] = {
         {"-dimensionless", NULL,
          "add the thesis' X = x/sqrt(R h0), P (T-38, T-39), H = h/h0; soft EHL: X = x/b, "
@@ -65,6 +66,10 @@ int main(int argc, char **argv)
          LUB_OPT_FLAG, &dimensionless},
         {"-o", "FILE", "write the table to FILE ('-': standard output) instead of postProcessing",
          LUB_OPT_STR, &out_file},
+        {"-inlet", "X",
+         "the inlet x instead of 'inlet' of system/reynoldsRefDict.yaml (e.g. the inlet "
+         "meniscus of an MPS run: probe film)",
+         LUB_OPT_REAL, &inlet},
         {0}};
     lub_program_info info = {
         .name = "reynoldsRef",
@@ -105,6 +110,14 @@ int main(int argc, char **argv)
     char path[LUB_PATH_MAX];
     lub_refcase rc;
     lub_refcase_read(&rc, &c);
+    if (isfinite(inlet)) {
+        double end = rc.s.bc == LUB_REYNOLDS_BC_GIVEN_EXIT ? rc.s.exit_x : rc.s.outlet;
+        if (!(inlet < end))
+            lub_fatal("-inlet %g: the inlet must lie before the %s (%g) of "
+                      "system/reynoldsRefDict.yaml",
+                      inlet, rc.s.bc == LUB_REYNOLDS_BC_GIVEN_EXIT ? "exit" : "outlet", end);
+        rc.s.inlet = inlet;
+    }
     const lub_refcase_settings *s = &rc.s;
     if (dimensionless) lub_refcase_check_scales(&rc);
 
