@@ -28,6 +28,7 @@
 #include "io/dict.h"
 #include "models/models.h"
 #include "models/transport.h"
+#include "mps/levels.h"
 #include "mps/mps.h"
 #include "mps/operators.h"
 
@@ -115,7 +116,8 @@ static void read_solution(lub_mps_config *c, const char *path)
     }
 }
 
-static void read_models(lub_mps_config *c, const char *path, const lub_particles *P)
+static void read_models(lub_mps_config *c, const char *path, const char *geometry_path,
+                        const lub_particles *P)
 {
     static const char *const visc[] = {"explicit", "crankNicolson", NULL};
     lub_dict *d = lub_dict_read_optional(path);
@@ -149,12 +151,20 @@ static void read_models(lub_mps_config *c, const char *path, const lub_particles
     c->restitution = lub_dict_real_or(col, "restitution", c->restitution, LUB_UNIT);
 
     /* elasticWall is read by mps/elastic_wall.c (it needs the geometry) */
+    /* multiResolution is read and checked by mps/levels.c against particleGenDict's levels,
+     * so that a bad entry is reported with its line; the solver does not run it yet */
     lub_node *mr = lub_dict_find(r, "multiResolution");
-    if (mr)
+    if (mr) {
+        lub_levels lv;
+        char desc[1024];
+        lub_levels_read_case(&lv, mr, geometry_path, P);
+        lub_dict_finish(d); /* a misspelt key first */
+        lub_levels_describe(&lv, desc, sizeof desc);
         lub_node_error(mr,
-                       "model 'multiResolution' is not available in this version of lubFoam "
-                       "(remove it from %s)",
-                       path);
+                       "model 'multiResolution' is not available in this version of lubFoam: "
+                       "the solver runs single-resolution cases only (the entry is valid: %s)",
+                       desc);
+    }
     if (d) {
         lub_dict_finish(d);
         lub_dict_free(d);
@@ -169,7 +179,9 @@ void lub_mps_config_read(lub_mps_config *c, const char *case_dir, const lub_part
     lub_case_open(&cs, case_dir);
     lub_transport_read(lub_case_path(&cs, path, "constant/transportProperties.yaml"), &c->rho,
                        &c->nu);
-    read_models(c, lub_case_path(&cs, path, "constant/models.yaml"), P);
+    char geometry_path[LUB_PATH_MAX];
+    lub_case_path(&cs, geometry_path, "system/particleGenDict.yaml");
+    read_models(c, lub_case_path(&cs, path, "constant/models.yaml"), geometry_path, P);
     read_schemes(c, lub_case_path(&cs, path, "system/schemes.yaml"));
     read_solution(c, lub_case_path(&cs, path, "system/solution.yaml"));
 }
