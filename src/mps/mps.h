@@ -12,7 +12,8 @@
  *     6. pressure Poisson equation                 (T-9, T-10), Dirichlet p = 0 on the surface
  *     7. pressure gradient                         standard (T-13, T-14) or LSMPS (T-15)
  *     8. u^{k+1} = u* - dt/rho grad p, r^{k+1} = r* + (u^{k+1} - u*) dt   (T-16, T-17)
- *     9. collision, periodic wrap, checks
+ *     9. collision, periodic wrap, checks (non-finite values, the domain box, a fluid
+ *        particle through a wall: lub_mps_check)
  *
  * Pressure predictor (schemes.yaml pressure.predictor, not in the thesis).  Without it, a
  * steady flow balances grad p / rho = nu lap(u*) with u* = u + dt grad p / rho: the viscous
@@ -157,13 +158,24 @@ typedef enum {
     LUB_STEP_OK = 0,
     LUB_STEP_SOLVE_FAILED, /* a linear solve failed and the dictionary says stop */
     LUB_STEP_NONFINITE,    /* NaN or Inf in a particle value */
-    LUB_STEP_ESCAPED,      /* a particle left the domain through a non-periodic side */
+    LUB_STEP_ESCAPED,      /* a particle left the domain through a non-periodic side, or a
+                              fluid particle went through a wall (elasticWall: a wall would
+                              cross the plate, mps/elastic_wall.h) */
 } lub_step_status;
 
 /* Advance by dt.  On failure, *bad is the index of the first offending particle (or -1) and
  * msg describes it; the particle state is then undefined (the caller keeps its last good
  * time folder). */
 lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize);
+
+/* The checks at the end of lub_mps_step, on the current state: the first particle with a
+ * non-finite value (LUB_STEP_NONFINITE) or outside the domain box in a non-periodic direction
+ * (LUB_STEP_ESCAPED), then the first fluid particle that went through a wall in the step of
+ * length dt that brought the particles here, their positions before it being r - u dt
+ * (LUB_STEP_ESCAPED, naming the wall's patch; the criterion is described in step.c).  *bad
+ * and msg as for lub_mps_step.  Uses the neighbour lists of the step: a caller that places
+ * particles itself builds them first (lub_neighbours_build(&m->nb, P->n, P->x)). */
+lub_step_status lub_mps_check(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize);
 
 /* Build the neighbour lists afresh at the next step.  The solver calls it after writing a
  * time folder, so that a run restarted from that folder (whose lists are built afresh)

@@ -368,23 +368,6 @@ size_t lub_neighbours_build(lub_neighbours *nb, size_t n, double *const x[3])
     return escaped;
 }
 
-/* Minimum image of a coordinate difference v for period L (L = 0: not periodic).  Positions
- * kept within the box need at most one period added or removed; the floor is the rare
- * fallback for positions further out. */
-static inline double min_image(double v, double L)
-{
-    if (L == 0.0) return v;
-    const double half = 0.5 * L;
-    if (v > half) {
-        v -= L;
-        if (v > half) v -= L * floor(v / L + 0.5);
-    } else if (v < -half) {
-        v += L;
-        if (v < -half) v -= L * floor(v / L + 0.5);
-    }
-    return v;
-}
-
 /* Pairs of particle i at the new positions; dim is a literal at the call sites so that the
  * component loops unroll. */
 static inline void update_particle(lub_neighbours *nb, double *const x[3], size_t i,
@@ -396,7 +379,7 @@ static inline void update_particle(lub_neighbours *nb, double *const x[3], size_
         const size_t j = nb->j[k];
         double r2 = 0.0;
         for (int d = 0; d < dim; d++) {
-            const double v = min_image(x[d][j] - xi[d], L[d]);
+            const double v = lub_min_image(x[d][j] - xi[d], L[d]);
             nb->dx[d][k] = v;
             r2 += v * v;
         }
@@ -417,7 +400,7 @@ size_t lub_neighbours_update(lub_neighbours *nb, double *const x[3])
         /* displacement since the build (positions then: xs, wrapped), minimum image */
         double d2 = 0.0;
         for (int d = 0; d < dim; d++) {
-            const double v = min_image(x[d][i] - nb->xs[d][nb->spos[i]], L[d]);
+            const double v = lub_min_image(x[d][i] - nb->xs[d][nb->spos[i]], L[d]);
             d2 += v * v;
         }
         if (!(d2 <= lim * lim)) moved++;

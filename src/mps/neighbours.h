@@ -42,6 +42,7 @@
 #ifndef LUB_MPS_NEIGHBOURS_H
 #define LUB_MPS_NEIGHBOURS_H
 
+#include <math.h>
 #include <stddef.h>
 #include <stdint.h>
 
@@ -99,6 +100,38 @@ size_t lub_neighbours_build(lub_neighbours *nb, size_t n, double *const x[3]);
  * skin re / 2 since the build; returns the number of particles that moved further (0: the
  * lists are complete; otherwise rebuild). */
 size_t lub_neighbours_update(lub_neighbours *nb, double *const x[3]);
+
+/* Minimum image of a coordinate difference v for period L (L = 0: not periodic).  Positions
+ * kept within the box need at most one period added or removed; the floor is the rare
+ * fallback for positions further out. */
+static inline double lub_min_image(double v, double L)
+{
+    if (L == 0.0) return v;
+    const double half = 0.5 * L;
+    if (v > half) {
+        v -= L;
+        if (v > half) v -= L * floor(v / L + 0.5);
+    } else if (v < -half) {
+        v += L;
+        if (v < -half) v -= L * floor(v / L + 0.5);
+    }
+    return v;
+}
+
+/* r_ij = r_j - r_i at the positions x (minimum image in periodic directions), not at those
+ * of the last build or update: for a pair of the lists after the particles have moved on.
+ * Returns |r_ij|^2; v (3 components, v[2] = 0 in 2-D) may be NULL. */
+static inline double lub_neighbours_r(const lub_neighbours *nb, double *const x[3], size_t i,
+                                      size_t j, double *v)
+{
+    double r2 = 0.0, c[3] = {0.0, 0.0, 0.0};
+    for (int d = 0; d < nb->dim; d++) {
+        c[d] = lub_min_image(x[d][j] - x[d][i], nb->periodic[d] ? nb->period[d] : 0.0);
+        r2 += c[d] * c[d];
+    }
+    if (v) v[0] = c[0], v[1] = c[1], v[2] = c[2];
+    return r2;
+}
 
 /* Apply a permutation to one per-particle array of n elements of elsize bytes:
  * a_new[k] = a_old[perm[k]].  scratch holds at least n * elsize bytes. */

@@ -224,7 +224,10 @@ int main(int argc, char **argv)
             "  advances to endTime (or nSteps), writes time folders and the tables of\n"
             "  the function objects, and reports its cost in\n"
             "  postProcessing/cost/<startTime>/cost.dat.  SIGINT/SIGTERM write the\n"
-            "  current state and exit 0.",
+            "  current state and exit 0.  A non-finite value, a particle leaving the\n"
+            "  domain or a fluid particle going through a wall stops the run with exit 2,\n"
+            "  naming the particle (and the wall) and the step; the newest time folder is\n"
+            "  then the last good state.",
         .dictionaries = "system/controlDict.yaml\nsystem/particleGenDict.yaml (domain)\n"
                         "system/schemes.yaml\nsystem/solution.yaml (optional)\n"
                         "constant/transportProperties.yaml\nconstant/models.yaml",
