@@ -12,7 +12,7 @@ set ylabel "p [kPa]"
 set xrange [-1.5:1]
 set yrange [0:*]
 set grid
-set key top left
+set key top right
 plot "postProcessing/reynoldsRef/0/p.dat" using ($1*1e3):($2*1e-3) with lines lw 2 lc rgb "black" \
          title "Reynolds equation (reynoldsRef, inlet at the MPS meniscus)", \
      "postProcessing/wallPressure/0/p.dat" using ($1*1e3):($2*1e-3) with points pt 7 ps 0.6 \
