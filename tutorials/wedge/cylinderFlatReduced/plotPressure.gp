@@ -14,6 +14,6 @@ set yrange [0:*]
 set grid
 set key top right
 plot "postProcessing/reynoldsRef/0/p.dat" using ($1*1e3):($2*1e-3) with lines lw 2 lc rgb "black" \
-         title "Reynolds equation (reynoldsRef, inlet at the MPS meniscus)", \
+         title "Reynolds, inlet at MPS meniscus", \
      "postProcessing/wallPressure/0/p.dat" using ($1*1e3):($2*1e-3) with points pt 7 ps 0.6 \
-         lc rgb "red" title "MPS (lubFoam), cylinder wall, mean over 0.6-1.2 ms"
+         lc rgb "red" title "MPS, mean 0.6-1.2 ms"
