@@ -36,6 +36,8 @@ typedef struct {
     double tol;                       /* geometric tolerance (1e-6 of the finest l0) */
     int level;                        /* level being generated */
     int wall;                         /* wall being generated */
+    int only;                         /* >= 0: lub_geometry_discretise_range: this level */
+    double xlo, xhi;                  /*   owns [xlo, xhi] (walls: padded), no other level */
 } gen_ctx;
 
 static double dot3(const double *a, const double *b)
@@ -51,6 +53,14 @@ static int level_of(const lub_geometry *g, double x)
     for (int k = 0; k < g->nlevels; k++)
         if (g->levels[k].has_region && x >= g->levels[k].xmin && x <= g->levels[k].xmax) return k;
     return g->levels[g->nlevels - 1].has_region ? -1 : g->nlevels - 1;
+}
+
+/* Whether the level being generated takes a point at x: it owns x, or (a range) x lies in
+ * the range. */
+static int takes(const gen_ctx *c, double x)
+{
+    if (c->only >= 0) return x >= c->xlo && x <= c->xhi;
+    return level_of(c->g, x) == c->level;
 }
 
 static int in_domain(const lub_geometry *g, const double *x, double tol)
@@ -122,7 +132,7 @@ static void push(gen_ctx *c, const double *x, int kind)
     const lub_geometry *g = c->g;
     double p[3] = {x[0], x[1], g->dim == 3 ? x[2] : 0.0};
     if (!in_domain(g, p, c->tol)) return;
-    if (level_of(g, p[0]) != c->level) return;
+    if (!takes(c, p[0])) return;
     gen_vec *v = &c->pts;
     if (v->n == v->cap) {
         v->cap = v->cap ? 2 * v->cap : 1024;
@@ -743,14 +753,20 @@ static void check_memory(const lub_geometry *g, double mem)
 
 /* ---- the whole generation ------------------------------------------------------------- */
 
-void lub_geometry_discretise(const lub_geometry *g, lub_particles *P, double mem_bytes,
-                             size_t *region_counts)
+/* The generation: every level in what it owns (only < 0), or level `only` in [xlo, xhi]
+ * (walls generated over [xlo - pad, xhi + pad] so that the fluid keeps its gap from the
+ * walls just outside the range, then cut to the range). */
+static void discretise(const lub_geometry *g, lub_particles *P, int only, double xlo, double xhi,
+                       size_t *region_counts)
 {
-    check_memory(g, mem_bytes);
     gen_ctx c;
     memset(&c, 0, sizeof c);
     c.g = g;
     c.tol = 1e-6 * g->levels[0].l0;
+    c.only = only;
+    const double pad = only >= 0 ? (g->wall_gap + 1.0) * g->levels[only].l0 : 0.0;
+    c.xlo = xlo - pad;
+    c.xhi = xhi + pad;
     set_origins(&c);
     for (int i = 0; i < g->nwalls; i++) {
         const lub_wall *w = &g->walls[i];
@@ -767,10 +783,11 @@ void lub_geometry_discretise(const lub_geometry *g, lub_particles *P, double mem
         c.wall = i;
         size_t before = c.pts.n;
         for (int k = 0; k < g->nlevels; k++) {
+            if (only >= 0 && k != only) continue;
             c.level = k;
             discretise_wall(&c, &g->walls[i]);
         }
-        if (c.pts.n == before)
+        if (c.pts.n == before && only < 0)
             lub_warning("%s:%d: wall '%s' has no particles inside the domain",
                         lub_node_file(g->walls[i].node), lub_node_line(g->walls[i].node),
                         g->walls[i].name);
@@ -810,7 +827,10 @@ void lub_geometry_discretise(const lub_geometry *g, lub_particles *P, double mem
     /* fluid on each level's lattice */
     grid_build(&cg, g, &c.pts.p, nw, fmax(lmax, gapmax));
     size_t *rc = lub_calloc(g->nregions ? (size_t)g->nregions : 1, sizeof *rc);
+    c.xlo = xlo;
+    c.xhi = xhi;
     for (int k = 0; k < g->nlevels && g->nregions; k++) {
+        if (only >= 0 && k != only) continue;
         double l0 = g->levels[k].l0, tol = 1e-6 * l0, gap = 0.999 * g->wall_gap * l0;
         double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
         for (int r = 0; r < g->nregions; r++) {
@@ -818,7 +838,9 @@ void lub_geometry_discretise(const lub_geometry *g, lub_particles *P, double mem
             region_bbox(g, &g->regions[r], a, b);
             for (int d = 0; d < 3; d++) lo[d] = fmin(lo[d], a[d]), hi[d] = fmax(hi[d], b[d]);
         }
-        if (g->levels[k].has_region)
+        if (only >= 0)
+            lo[0] = fmax(lo[0], xlo), hi[0] = fmin(hi[0], xhi);
+        else if (g->levels[k].has_region)
             lo[0] = fmax(lo[0], g->levels[k].xmin), hi[0] = fmin(hi[0], g->levels[k].xmax);
         long i0[3] = {0, 0, 0}, i1[3] = {0, 0, 0};
         for (int d = 0; d < g->dim; d++)
@@ -830,7 +852,7 @@ void lub_geometry_discretise(const lub_geometry *g, lub_particles *P, double mem
                 for (long e = i0[2]; e <= i1[2]; e++) {
                     double x[3] = {c.origin[k][0] + a * l0, c.origin[k][1] + b * l0,
                                    g->dim == 3 ? c.origin[k][2] + e * l0 : 0.0};
-                    if (level_of(g, x[0]) != k || !in_domain(g, x, c.tol)) continue;
+                    if (!takes(&c, x[0]) || !in_domain(g, x, c.tol)) continue;
                     int inside = 0;
                     for (int r = 0; r < g->nregions; r++)
                         if (in_region(g, &g->regions[r], x, tol)) inside = 1;
@@ -846,7 +868,7 @@ void lub_geometry_discretise(const lub_geometry *g, lub_particles *P, double mem
                 }
     }
     grid_free(&cg);
-    for (int r = 0; r < g->nregions; r++)
+    for (int r = 0; r < g->nregions && only < 0; r++)
         if (rc[r] == 0) {
             const lub_region *rg = &g->regions[r];
             char what[256];
@@ -878,7 +900,23 @@ void lub_geometry_discretise(const lub_geometry *g, lub_particles *P, double mem
         lub_level_reference(g->dim, g->levels[k].l0, &P->levels[k]);
     for (size_t i = 0; i < c.pts.n; i++) {
         const gen_pt *q = &c.pts.p[i];
+        if (only >= 0 && !(q->x[0] >= xlo && q->x[0] <= xhi)) continue; /* padding */
         lub_particles_add(P, q->x, q->kind, q->kind == LUB_FLUID ? 0 : q->wall, q->level);
     }
     free(c.pts.p);
+}
+
+void lub_geometry_discretise(const lub_geometry *g, lub_particles *P, double mem_bytes,
+                             size_t *region_counts)
+{
+    check_memory(g, mem_bytes);
+    discretise(g, P, -1, 0.0, 0.0, region_counts);
+}
+
+void lub_geometry_discretise_range(const lub_geometry *g, int level, double xlo, double xhi,
+                                   lub_particles *P)
+{
+    if (level < 0 || level >= g->nlevels || !(xlo <= xhi))
+        lub_bug("discretise_range: level %d of %d, x in [%g, %g]", level, g->nlevels, xlo, xhi);
+    discretise(g, P, level, xlo, xhi, NULL);
 }

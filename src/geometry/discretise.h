@@ -44,6 +44,14 @@ double lub_geometry_estimate(const lub_geometry *g);
 void lub_geometry_discretise(const lub_geometry *g, lub_particles *P, double mem_bytes,
                              size_t *region_counts);
 
+/* The wall, dummy and fluid particles level `level` would have in x in [xlo, xhi] if it
+ * owned that range (same lattice, same wall sampling and fluid rules as
+ * lub_geometry_discretise), into P (initialised here; all levels and patches of g set).  An
+ * empty result is not an error.  The multi-resolution solver fills the overlap margins with
+ * it (particleGen generates each level only where it owns x; mps/opt.h). */
+void lub_geometry_discretise_range(const lub_geometry *g, int level, double xlo, double xhi,
+                                   lub_particles *P);
+
 /* 1 when point x lies behind wall w (inside its solid, deeper than tol) within the wall's
  * span (x-range for planes, segments and polylines). */
 int lub_wall_behind(const lub_wall *w, const double *x, int dim, double tol);

@@ -116,8 +116,27 @@ static void read_solution(lub_mps_config *c, const char *path)
     }
 }
 
+/* What the multi-resolution solver (mps/opt.h) cannot run yet: refused with the entry's
+ * line.  Called after lub_dict_finish, so that a misspelt key is reported first. */
+static void check_supported(const lub_levels *L, lub_node *mr, lub_node *root)
+{
+    if (L->mass_correction)
+        lub_node_error(lub_dict_find(mr, "massCorrection"),
+                       "multiResolution: 'massCorrection' (T-27..T-29) is not available in this "
+                       "version of lubFoam: remove it (the mass with each point on one level is "
+                       "reported by the totals function object)");
+    if (L->nlevels > 2)
+        lub_node_error(mr, "multiResolution: %d levels: this version of lubFoam runs 2 levels",
+                       L->nlevels);
+    lub_node *ew = lub_dict_find(root, "elasticWall");
+    if (ew)
+        lub_node_error(ew, "model 'elasticWall' with 'multiResolution' is not available in this "
+                           "version of lubFoam: the elastic wall across levels (T-62..T-65) is "
+                           "still to come");
+}
+
 static void read_models(lub_mps_config *c, const char *path, const char *geometry_path,
-                        const lub_particles *P)
+                        const lub_particles *P, lub_levels *L)
 {
     static const char *const visc[] = {"explicit", "crankNicolson", NULL};
     lub_dict *d = lub_dict_read_optional(path);
@@ -152,18 +171,28 @@ static void read_models(lub_mps_config *c, const char *path, const char *geometr
 
     /* elasticWall is read by mps/elastic_wall.c (it needs the geometry) */
     /* multiResolution is read and checked by mps/levels.c against particleGenDict's levels,
-     * so that a bad entry is reported with its line; the solver does not run it yet */
+     * so that a bad entry is reported with its line; a caller without L cannot run it */
     lub_node *mr = lub_dict_find(r, "multiResolution");
+    if (L) L->nlevels = 0;
     if (mr) {
         lub_levels lv;
         char desc[1024];
         lub_levels_read_case(&lv, mr, geometry_path, P);
         lub_dict_finish(d); /* a misspelt key first */
         lub_levels_describe(&lv, desc, sizeof desc);
-        lub_node_error(mr,
-                       "model 'multiResolution' is not available in this version of lubFoam: "
-                       "the solver runs single-resolution cases only (the entry is valid: %s)",
-                       desc);
+        if (!L)
+            lub_node_error(mr,
+                           "model 'multiResolution' is not available in this program (the "
+                           "entry is valid: %s)",
+                           desc);
+        check_supported(&lv, mr, r);
+        *L = lv;
+    } else if (P->nlevels > 1) {
+        lub_fatal("%s: the particles have %d resolution levels but there is no "
+                  "'multiResolution' entry: add one (e.g. 'multiResolution: { commonDeltaT: "
+                  "true }', etc/templates/models.yaml) or generate a single level (l0 in "
+                  "system/particleGenDict.yaml)",
+                  path, P->nlevels);
     }
     if (d) {
         lub_dict_finish(d);
@@ -171,7 +200,8 @@ static void read_models(lub_mps_config *c, const char *path, const char *geometr
     }
 }
 
-void lub_mps_config_read(lub_mps_config *c, const char *case_dir, const lub_particles *P)
+void lub_mps_config_read(lub_mps_config *c, const char *case_dir, const lub_particles *P,
+                         lub_levels *L)
 {
     lub_case cs;
     char path[LUB_PATH_MAX];
@@ -181,7 +211,7 @@ void lub_mps_config_read(lub_mps_config *c, const char *case_dir, const lub_part
                        &c->nu);
     char geometry_path[LUB_PATH_MAX];
     lub_case_path(&cs, geometry_path, "system/particleGenDict.yaml");
-    read_models(c, lub_case_path(&cs, path, "constant/models.yaml"), geometry_path, P);
+    read_models(c, lub_case_path(&cs, path, "constant/models.yaml"), geometry_path, P, L);
     read_schemes(c, lub_case_path(&cs, path, "system/schemes.yaml"));
     read_solution(c, lub_case_path(&cs, path, "system/solution.yaml"));
 }

@@ -44,6 +44,7 @@
 
 #include "core/timer.h"
 #include "linalg/linsolve.h"
+#include "mps/levels.h"
 #include "mps/neighbours.h"
 #include "particles/particles.h"
 
@@ -84,13 +85,24 @@ typedef struct {
     int collision;
     double collision_distance; /* in l0 */
     double restitution;
+
+    /* set by the multi-resolution driver (mps/opt.h), not read from a dictionary */
+    int fixed_flags; /* allocate lub_mps.fixed: particles whose velocity and pressure are given */
+    int still_walls; /* wall and dummy particles keep their positions while carrying their
+                        patch velocity: every wall is at rest or a plane sliding along itself,
+                        so that the walls of a level stay in the part of x the level covers */
 } lub_mps_config;
 
 /* The defaults of every entry (those of etc/templates/schemes.yaml and solution.yaml). */
 void lub_mps_config_defaults(lub_mps_config *c);
 /* Read the dictionaries of a case into c, checking patch names against the particles'
- * patches.  Fatal (exit 1) with file:line on bad input.  case_dir is the case root. */
-void lub_mps_config_read(lub_mps_config *c, const char *case_dir, const lub_particles *P);
+ * patches.  Fatal (exit 1) with file:line on bad input.  case_dir is the case root.
+ * L (may be NULL) receives constant/models.yaml's multiResolution entry, checked against
+ * system/particleGenDict.yaml and P (mps/levels.h), or L->nlevels = 0 without one; a
+ * configuration the multi-resolution solver (mps/opt.h) cannot run yet is refused, and so is
+ * an entry when L is NULL, and particles of several levels without an entry. */
+void lub_mps_config_read(lub_mps_config *c, const char *case_dir, const lub_particles *P,
+                         lub_levels *L);
 
 /* What the last step did, for the log and the cost table. */
 typedef struct {
@@ -135,9 +147,15 @@ typedef struct {
     double *grad[3];
     double *gbar[3]; /* predictor: running mean of the pressure gradient (particle extra
                         fields gradPx, gradPy, gradPz, so that it is saved and reordered) */
-    double *cav; /* negativePressure cavitation: 1 where the pressure is held at 0 (particle
-                    extra field "cavitation", so that it is saved and reordered), else NULL */
+    double *cav;     /* negativePressure cavitation: 1 where the pressure is held at 0 (particle
+                        extra field "cavitation", so that it is saved and reordered), else NULL */
     double *lap;
+    uint8_t *fixed; /* multi-resolution fixed band (T-25, T-26; mps/opt.h): 1 where a fluid or
+                       wall particle's velocity and pressure are given (interpolated from another
+                       level before the step): such a particle is a Dirichlet row of the
+                       viscosity (fluid) and pressure equations, keeps its velocity through the
+                       step and moves with it (r* = r + u dt, no correction, no collision).
+                       Reordered with the particles.  NULL unless config.fixed_flags. */
     void *scratch;
     long steps; /* global step count (from the particle file) */
     int built;  /* neighbour lists built once */
@@ -147,8 +165,10 @@ typedef struct {
 } lub_mps;
 
 /* Set up the solver for particles P (the state lives in P; its capacity must not change
- * while the solver runs).  domain box and periodicity from lo/hi/periodic.  Computes re, n0
- * and lambda0 from l0 (level 0) and writes them into P->levels[0]. */
+ * while the solver runs: the work arrays are allocated for P->cap particles, so P->n may grow
+ * up to it between steps).  domain box and periodicity from lo/hi/periodic.  Computes re, n0
+ * and lambda0 from l0 (level 0) and writes them into P->levels[0].  P must hold one
+ * resolution level: a multi-resolution set is solved level by level (mps/opt.h). */
 void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const double lo[3],
                   const double hi[3], const int periodic[3]);
 void lub_mps_free(lub_mps *m);

@@ -30,9 +30,9 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
     m->P = P;
     m->dim = P->dim;
     if (P->nlevels > 1)
-        lub_fatal("the particles have %d resolution levels: multi-resolution is not available "
-                  "in this version of lubFoam",
-                  P->nlevels);
+        lub_bug("lub_mps_init: the particles have %d resolution levels; a solver takes one "
+                "(multi-resolution: one solver per level, mps/opt.h)",
+                P->nlevels);
     m->l0 = P->levels[0].l0;
     if (!(m->l0 > 0)) lub_fatal("particle file has no valid l0 for level 0");
     m->re = c->re_l0 * m->l0;
@@ -51,13 +51,15 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
     lub_linsolver_init(&m->psolver, &c->p_solver);
     lub_linsolver_init(&m->vsolver, &c->v_solver);
 
-    size_t n = P->n;
+    /* work arrays for the capacity: particles generated between steps (multi-resolution)
+     * need no allocation */
+    size_t n = P->cap > P->n ? P->cap : P->n;
     m->cap = n;
     static const char *const gbar_names[3] = {"gradPx", "gradPy", "gradPz"};
     for (int d = 0; d < 3; d++)
         m->gbar[d] = c->predictor > 0 && d < m->dim ? lub_particles_extra(P, gbar_names[d]) : NULL;
-    m->cav = c->clip_negative == LUB_NEGATIVE_CAVITATION ? lub_particles_extra(P, "cavitation")
-                                                          : NULL;
+    m->cav =
+        c->clip_negative == LUB_NEGATIVE_CAVITATION ? lub_particles_extra(P, "cavitation") : NULL;
     for (int d = 0; d < 3; d++) {
         m->us[d] = alloc_doubles(n);
         m->bv[d] = alloc_doubles(n);
@@ -72,6 +74,7 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
     m->row = lub_calloc(n ? n : 1, sizeof *m->row);
     m->prow = lub_calloc(n ? n : 1, sizeof *m->prow);
     m->scratch = lub_malloc((n ? n : 1) * sizeof(double));
+    m->fixed = c->fixed_flags ? lub_calloc(n ? n : 1, 1) : NULL;
     for (int k = 0; k < LUB_T_COUNT; k++) lub_timers_add(&m->tm, lub_mps_phase_names[k]);
 }
 
@@ -91,6 +94,7 @@ void lub_mps_free(lub_mps *m)
     free(m->row);
     free(m->prow);
     free(m->scratch);
+    free(m->fixed);
     lub_neighbours_free(&m->nb);
     lub_csr_free(&m->A);
     lub_linsolver_free(&m->psolver);
@@ -116,6 +120,7 @@ static void reorder(lub_mps *m)
     arrays[k] = P->level, sizes[k++] = sizeof *P->level;
     arrays[k] = P->id, sizes[k++] = sizeof *P->id;
     for (int e = 0; e < P->nextra; e++) arrays[k] = P->extra[e].v, sizes[k++] = sizeof(double);
+    if (m->fixed) arrays[k] = m->fixed, sizes[k++] = sizeof *m->fixed;
     lub_reorder_set(P->n, m->nb.perm, m->scratch, k, arrays, sizes);
 }
 
@@ -150,7 +155,9 @@ static void begin_rows(lub_mps *m, int nrows)
 }
 
 /* Viscosity and body force -> u* (T-7 explicit, T-31 Crank-Nicolson).  Wall and dummy
- * particles keep their prescribed velocity and act as Dirichlet values.
+ * particles keep their prescribed velocity and act as Dirichlet values, and so do the fluid
+ * particles of a multi-resolution fixed band (m->fixed: the thesis' fixed temporary velocity,
+ * T-25, T-26, the Dirichlet condition of the implicit viscosity step of §2-2-2 (3)).
  *
  * dummy_velocity: wall particles lie on the wall and carry its velocity U.  Dummy particles
  * lie behind it, where the no-slip profile continued through the wall is 2 U - u (mirror
@@ -200,6 +207,8 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
     const size_t n = P->n;
     const int dim = m->dim;
     const double *g = m->c.g;
+    /* a fixed-band particle (m->fixed) keeps its given velocity: u* = u, a Dirichlet value */
+    const uint8_t *fix = m->fixed;
     lub_timer_start(&m->tm, LUB_T_VISCOSITY);
     for (int d = 0; d < 3; d++) memcpy(m->us[d], P->u[d], n * sizeof(double));
     /* pressure predictor: the viscous step feels the running mean of the pressure gradient,
@@ -214,7 +223,7 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
         const double gm = m->c.mirror_dummies ? 2.0 : 1.0;
 #pragma omp parallel for schedule(static)
         for (size_t i = 0; i < n; i++) {
-            if (P->kind[i] != LUB_FLUID) continue;
+            if (P->kind[i] != LUB_FLUID || (fix && fix[i])) continue;
             double acc[3] = {0, 0, 0};
             for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
                 double w = nb->w[q];
@@ -227,14 +236,16 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
         }
     } else if (m->c.viscosity == LUB_VISCOSITY_CN) {
         /* (T-31): u*_i - (dt nu/2) <lap u*>_i = u_i + (dt nu/2) <lap u^k>_i + dt g, with the
-         * wall and dummy velocities known.  Rows: fluid particles; symmetric since w_ij is. */
+         * wall, dummy (and fixed-band) velocities known.  Rows: the other fluid particles;
+         * symmetric since w_ij is. */
         const double k = 0.5 * dt * m->c.nu * 2.0 * dim / (m->lambda0 * m->n0);
         const lub_neighbours *nb = &m->nb;
         const double gm = m->c.mirror_dummies ? 2.0 : 1.0;
         int nf = 0;
         for (size_t i = 0; i < n; i++) {
-            m->row[i] = P->kind[i] == LUB_FLUID ? nf : -1;
-            if (P->kind[i] == LUB_FLUID) m->prow[nf++] = (int)i;
+            const int unknown = P->kind[i] == LUB_FLUID && !(fix && fix[i]);
+            m->row[i] = unknown ? nf : -1;
+            if (unknown) m->prow[nf++] = (int)i;
         }
         begin_rows(m, nf);
 #pragma omp parallel for schedule(static)
@@ -289,7 +300,7 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
         for (int d = 0; d < dim; d++)
 #pragma omp parallel for schedule(static)
             for (size_t i = 0; i < n; i++)
-                if (P->kind[i] == LUB_FLUID)
+                if (P->kind[i] == LUB_FLUID && !(fix && fix[i]))
                     m->us[d][i] += dt * (g[d] - (gold ? rinv * gold[d][i] : 0.0));
     }
     if (rinv != 0.0)
@@ -298,7 +309,8 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
         for (int d = 0; d < dim; d++)
 #pragma omp parallel for schedule(static)
             for (size_t i = 0; i < n; i++)
-                if (P->kind[i] == LUB_FLUID) m->us[d][i] += dt * rinv * gold[d][i];
+                if (P->kind[i] == LUB_FLUID && !(fix && fix[i]))
+                    m->us[d][i] += dt * rinv * gold[d][i];
     lub_timer_stop(&m->tm, LUB_T_VISCOSITY);
     return 0;
 }
@@ -363,16 +375,22 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
     const double c = 2.0 * m->dim / (m->lambda0 * m->n0);
     const double src = m->c.gamma * m->c.rho / (dt * dt) / m->n0;
     const double alpha = m->c.alpha;
+    /* multi-resolution fixed band: the given pressure P->p of a fixed particle is a Dirichlet
+     * value (it wins over the free-surface test, whose truncated neighbourhood at the edge of
+     * a level's region means nothing); it enters the rows of its neighbours as c w_ij P_j */
+    const uint8_t *fix = m->fixed;
 
     lub_timer_start(&m->tm, LUB_T_ASSEMBLY);
     int nu = 0;
+    size_t nfix = 0;
     for (size_t i = 0; i < n; i++) {
         int unknown = P->kind[i] != LUB_DUMMY && !m->surface[i] && !(m->cav && m->cav[i] > 0);
+        if (fix && fix[i] && P->kind[i] != LUB_DUMMY) unknown = 0, nfix++;
         m->row[i] = unknown ? nu : -1;
         if (unknown) m->prow[nu++] = (int)i;
     }
     m->st.nunknowns = (size_t)nu;
-    if (nu > 0 && m->st.nsurface == 0 && alpha == 0) {
+    if (nu > 0 && m->st.nsurface == 0 && nfix == 0 && alpha == 0) {
         lub_timer_stop(&m->tm, LUB_T_ASSEMBLY);
         snprintf(msg, msgsize,
                  "the pressure equation has no Dirichlet particle (no free surface) and "
@@ -386,7 +404,7 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
         size_t i = (size_t)m->prow[r];
         int *col = lub_csr_row_col(&m->A, r);
         double *val = lub_csr_row_val(&m->A, r);
-        double wsum = 0;
+        double wsum = 0, bfix = 0;
         int e = 1;
         for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
             double w = nb->w[q];
@@ -396,11 +414,14 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
             if (m->row[j] >= 0) {
                 col[e] = m->row[j];
                 val[e++] = -c * w;
+            } else if (fix && fix[j]) {
+                bfix += w * P->p[j];
             }
         }
         col[0] = r;
         val[0] = c * wsum + alpha;
         m->b[r] = src * (m->pnd[i] - m->n0);
+        if (fix) m->b[r] += c * bfix;
         m->x[r] = P->p[i]; /* warm start from the previous pressure */
     }
     lub_csr_finish(&m->A);
@@ -428,6 +449,10 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
     double *cav = m->cav;
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
+        if (fix && fix[i] && P->kind[i] != LUB_DUMMY) { /* given: keep it */
+            if (cav) cav[i] = 0;
+            continue;
+        }
         double p = m->row[i] >= 0 ? m->x[m->row[i]] : 0.0;
         P->p[i] = (clip && p < 0) ? 0.0 : p;
         if (cav && m->row[i] >= 0) cav[i] = p < 0;
@@ -437,7 +462,7 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
 #pragma omp parallel for schedule(static)
         for (size_t i = 0; i < n; i++) {
             if (!(cav[i] > 0)) continue;
-            if (P->kind[i] == LUB_DUMMY || m->surface[i]) {
+            if (P->kind[i] == LUB_DUMMY || m->surface[i] || (fix && fix[i])) {
                 cav[i] = 0;
                 continue;
             }
@@ -468,7 +493,8 @@ static void collision(lub_mps *m, double dt)
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         double acc[3] = {0, 0, 0};
-        if (P->kind[i] == LUB_FLUID) {
+        /* a fixed-band particle keeps its given velocity (it still stops the others) */
+        if (P->kind[i] == LUB_FLUID && !(m->fixed && m->fixed[i])) {
             for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
                 double r2 = 0;
                 for (int d = 0; d < m->dim; d++) r2 += nb->dx[d][q] * nb->dx[d][q];
@@ -819,13 +845,21 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     /* 2. viscosity and body force */
     if (viscosity(m, dt, msg, msgsize)) return LUB_STEP_SOLVE_FAILED;
 
-    /* 3. temporary positions (T-8) */
+    /* 3. temporary positions (T-8); with still_walls only the fluid moves (the walls are at
+     * rest or slide along themselves: their particles carry the velocity in place) */
     lub_timer_start(&m->tm, LUB_T_OTHER);
     for (int d = 0; d < dim; d++) {
         double *x = P->x[d];
         const double *us = m->us[d];
+        if (m->c.still_walls) {
+            const uint8_t *kind = P->kind;
 #pragma omp parallel for schedule(static)
-        for (size_t i = 0; i < n; i++) x[i] += us[i] * dt;
+            for (size_t i = 0; i < n; i++)
+                if (kind[i] == LUB_FLUID) x[i] += us[i] * dt;
+        } else {
+#pragma omp parallel for schedule(static)
+            for (size_t i = 0; i < n; i++) x[i] += us[i] * dt;
+        }
     }
     lub_timer_stop(&m->tm, LUB_T_OTHER);
     neighbours(m, 0);
@@ -840,16 +874,17 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     /* 6. pressure */
     if (pressure(m, dt, msg, msgsize)) return LUB_STEP_SOLVE_FAILED;
 
-    /* 7. gradient, 8. correction (T-16, T-17) */
+    /* 7. gradient, 8. correction (T-16, T-17); a fixed-band particle keeps u* (given) */
     lub_timer_start(&m->tm, LUB_T_GRADIENT);
     m->st.nfallback = pressure_gradient(m, m->grad);
     const double f = dt / m->c.rho;
+    const uint8_t *fix = m->fixed;
     for (int d = 0; d < dim; d++) {
         double *u = P->u[d], *x = P->x[d];
         const double *us = m->us[d], *gr = m->grad[d];
 #pragma omp parallel for schedule(static)
         for (size_t i = 0; i < n; i++) {
-            if (P->kind[i] != LUB_FLUID) continue;
+            if (P->kind[i] != LUB_FLUID || (fix && fix[i])) continue;
             u[i] = us[i] - f * gr[i];
             x[i] += (u[i] - us[i]) * dt;
         }

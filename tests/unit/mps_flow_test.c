@@ -18,22 +18,11 @@
 #include <stdlib.h>
 #include <unistd.h>
 
+#include "flow.h"
 #include "geometry/discretise.h"
 #include "geometry/geometry.h"
 #include "mps/mps.h"
 #include "test.h"
-
-/* Generate particles from particleGenDict text. */
-static void generate(const char *text, lub_particles *P, lub_geometry *g)
-{
-    char path[] = "/tmp/lubflowXXXXXX";
-    int fd = mkstemp(path);
-    if (fd < 0 || write(fd, text, strlen(text)) != (ssize_t)strlen(text)) abort();
-    close(fd);
-    lub_geometry_read(g, path);
-    unlink(path);
-    lub_geometry_discretise(g, P, 0, NULL);
-}
 
 static int run(lub_mps *m, double dt, long nsteps)
 {
@@ -180,49 +169,6 @@ static const char *channel = "dimension: 2\n"
                              "  upper: { type: plane, point: [0, 0.02], normal: [0, -1] }\n"
                              "fluid:\n"
                              "  - { type: box, min: [0, 0], max: [0.02, 0.02] }\n";
-
-/* Mean x-velocity of the fluid in bins of height l0; relative L2 against u_ref(y). */
-static double profile_error(const lub_particles *P, int ax, double (*uref)(double, void *),
-                            void *ctx)
-{
-    enum { NB = 64 };
-    double sum[NB] = {0}, ysum[NB] = {0};
-    int cnt[NB] = {0};
-    const double l0 = P->levels[0].l0;
-    for (size_t i = 0; i < P->n; i++) {
-        if (P->kind[i] != LUB_FLUID) continue;
-        int b = (int)floor(P->x[ax][i] / l0 + 0.5);
-        if (b < 0 || b >= NB) continue;
-        sum[b] += P->u[0][i];
-        ysum[b] += P->x[ax][i];
-        cnt[b]++;
-    }
-    double e2 = 0, r2 = 0;
-    for (int b = 0; b < NB; b++) {
-        if (!cnt[b]) continue;
-        double y = ysum[b] / cnt[b], u = sum[b] / cnt[b], r = uref(y, ctx);
-        if (getenv("LUB_PROFILE")) printf("    y %.5f u %.6g ref %.6g n %d\n", y, u, r, cnt[b]);
-        e2 += (u - r) * (u - r);
-        r2 += r * r;
-    }
-    return sqrt(e2 / r2);
-}
-
-typedef struct {
-    double U, H, f, nu;
-} flow;
-
-static double couette(double y, void *c)
-{
-    flow *f = c;
-    return f->U * (f->H - y) / f->H;
-}
-
-static double poiseuille(double y, void *c)
-{
-    flow *f = c;
-    return f->f / (2 * f->nu) * y * (f->H - y);
-}
 
 /* Lower wall sliding at U; diffusion time H^2/nu = 0.4 s; run 5 of them to the steady
  * state.  The closed channel has no free surface, so the pressure equation needs the weak

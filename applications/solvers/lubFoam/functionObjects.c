@@ -8,7 +8,9 @@
  *                       timeStart: 0.024, timeEnd: 0.030 }     # averaging window
  *
  * totals.dat:  # t mass momentumX momentumY momentumZ kineticEnergy fluidParticles
- *              (per unit depth in 2-D: particle mass rho l0^d)
+ *              (per unit depth in 2-D: particle mass rho l0^d; multi-resolution: over the
+ *              fluid particles in the part of x their level owns, each point of space on one
+ *              level (T-27), with the mass rho l0^d of its level)
  * p.dat:       # x p n   wall pressure of the patch averaged over the window and the bin
  *              (n: samples); rewritten at every write time and at the end, with a second
  *              line "# samples S steps from t = A to t = B" (the steps averaged so far).
@@ -168,8 +170,8 @@ static void wall_pressure_resume(fo *o, lubfoam_run *r)
     o->samples = bestS;
     o->tfirst = bestA;
     o->tlast = r->t;
-    lub_message("function '%s': continues the average of %s (%ld steps from t = %g)", o->name,
-                best, bestS, bestA);
+    lub_message("function '%s': continues the average of %s (%ld steps from t = %g)", o->name, best,
+                bestS, bestA);
 }
 
 lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
@@ -206,12 +208,12 @@ lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
                                "function '%s': no patch '%s' in the particles (patches: %s)", name,
                                patch, list);
             }
-            o->from = lub_dict_real_or(d, "from", r->mps.lo[0], LUB_ANY);
-            o->to = lub_dict_real_or(d, "to", r->mps.hi[0], LUB_ANY);
+            o->from = lub_dict_real_or(d, "from", lubfoam_mps0(r)->lo[0], LUB_ANY);
+            o->to = lub_dict_real_or(d, "to", lubfoam_mps0(r)->hi[0], LUB_ANY);
             if (!(o->to > o->from))
                 lub_node_error(d, "function '%s': 'to' (%g) must be greater than 'from' (%g)", name,
                                o->to, o->from);
-            o->bin = lub_dict_real_or(d, "bin", 4 * r->mps.l0, LUB_POSITIVE);
+            o->bin = lub_dict_real_or(d, "bin", 4 * lubfoam_mps0(r)->l0, LUB_POSITIVE);
             o->t0 = lub_dict_real_or(d, "timeStart", 0.0, LUB_NONNEGATIVE);
             o->t1 = lub_dict_real_or(d, "timeEnd", INFINITY, LUB_NONNEGATIVE);
             o->nbins = (int)ceil((o->to - o->from) / o->bin - 1e-9);
@@ -233,17 +235,27 @@ static void totals(fo *o, lubfoam_run *r)
 {
     const lub_particles *P = &r->P;
     double mp = r->mps.c.rho * pow(r->mps.l0, P->dim);
-    double mom[3] = {0, 0, 0}, ke = 0;
+    double mom[3] = {0, 0, 0}, ke = 0, mass = 0;
     size_t nf = 0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->kind[i] != LUB_FLUID) continue;
+        if (r->opt) {
+            /* multi-resolution: each point of space counted on the level that owns it
+             * (T-27), with the particle mass of that level */
+            const int k = P->level[i];
+            lub_level_where w;
+            lub_levels_locate(&r->opt->L, P->x[0][i], &w);
+            if (w.owner != k) continue;
+            mp = r->opt->m[k].c.rho * pow(r->opt->m[k].l0, P->dim);
+        }
         nf++;
+        mass += mp;
         for (int d = 0; d < P->dim; d++) {
             mom[d] += mp * P->u[d][i];
             ke += 0.5 * mp * P->u[d][i] * P->u[d][i];
         }
     }
-    double row[7] = {r->t, mp * (double)nf, mom[0], mom[1], mom[2], ke, (double)nf};
+    double row[7] = {r->t, r->opt ? mass : mp * (double)nf, mom[0], mom[1], mom[2], ke, (double)nf};
     lub_table_write_row(o->fp, row, 7);
     fflush(o->fp);
 }
@@ -290,8 +302,8 @@ void lubfoam_functions_write(lubfoam_functions *F, lubfoam_run *r)
         if (!fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
         lub_table_write_header(fp, "x p n");
         if (o->samples)
-            fprintf(fp, "# samples %ld steps from t = %.17g to t = %.17g\n", o->samples,
-                    o->tfirst, o->tlast);
+            fprintf(fp, "# samples %ld steps from t = %.17g to t = %.17g\n", o->samples, o->tfirst,
+                    o->tlast);
         for (int b = 0; b < o->nbins; b++) {
             if (!o->count[b]) continue;
             double row[3] = {o->from + (b + 0.5) * o->bin, o->sum[b] / (double)o->count[b],

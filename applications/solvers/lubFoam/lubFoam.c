@@ -49,8 +49,21 @@ static double fraction_done(const lubfoam_run *r, long steps_done)
  * it.  At step 0 they count like the walls (a fluid given a velocity). */
 static void check_limits(lubfoam_run *r)
 {
-    const lub_mps *m = &r->mps;
+    /* multi-resolution: every level takes deltaT (commonDeltaT), so the finest level has the
+     * largest Courant and diffusion numbers for a speed; the speed is the fastest of all */
+    const lub_mps *m = lubfoam_mps0(r);
     double ufluid = lub_mps_max_speed(m), uwall = 0;
+    for (int k = 1; r->opt && k < r->opt->nlevels; k++)
+        ufluid = fmax(ufluid, lub_mps_max_speed(&r->opt->m[k]));
+    /* sub-stepping: a coarser level takes dt_factor deltaT; its Courant number, over the
+     * finest level's, is dt_factor l0_0 / l0_k (1 when Nr is the l0 ratio, T-19) */
+    double fac = 1;
+    for (int k = 1; r->opt && k < r->opt->nlevels; k++)
+        fac = fmax(fac, (double)r->opt->L.level[k].dt_factor * m->l0 / r->opt->m[k].l0);
+    if (fac > 1)
+        lub_message("multiResolution: Nr exceeds the l0 ratio: the coarse level's Courant "
+                    "number is %g times the fine level's (checked below)",
+                    fac);
     for (int k = 0; k < r->P.npatches; k++) {
         const double *v = m->c.patch_velocity[k];
         double s = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
@@ -59,11 +72,11 @@ static void check_limits(lubfoam_run *r)
     const int restart = r->step > 0;
     double umax = fmax(ufluid, uwall);
     double ucheck = restart && !r->ctl.adjust_time_step ? uwall : umax;
-    double co = umax * r->dt / m->l0;
+    double co = fac * umax * r->dt / m->l0;
     if (r->ctl.adjust_time_step && umax > 0) {
-        double dtc = r->ctl.max_courant * m->l0 / umax;
+        double dtc = r->ctl.max_courant * m->l0 / (fac * umax);
         if (dtc < r->dt) r->dt = dtc;
-        co = umax * r->dt / m->l0;
+        co = fac * umax * r->dt / m->l0;
     }
     double dn = m->c.nu * r->dt / (m->l0 * m->l0);
     lub_message("Stability: Courant %.4g (u_max %g m/s, dt %g s, l0 %g m; limit %g), "
@@ -73,7 +86,7 @@ static void check_limits(lubfoam_run *r)
                 : m->c.viscosity == LUB_VISCOSITY_EXPLICIT ? "explicit"
                                                            : "implicit",
                 m->c.viscosity == LUB_VISCOSITY_EXPLICIT ? ", limit maxDiffusion" : "");
-    double cocheck = ucheck * r->dt / m->l0;
+    double cocheck = fac * ucheck * r->dt / m->l0;
     if (cocheck > r->ctl.max_courant * (1 + 1e-9))
         lub_fatal("Courant number %.4g (u_max %g m/s x deltaT %g s / l0 %g m) exceeds maxCourant "
                   "%g in system/controlDict.yaml: reduce deltaT to at most %.4g s or set "
@@ -94,7 +107,7 @@ static void check_limits(lubfoam_run *r)
 
 static void print_header(const lubfoam_run *r)
 {
-    const lub_mps *m = &r->mps;
+    const lub_mps *m = lubfoam_mps0(r);
     size_t cnt[3] = {0, 0, 0};
     for (size_t i = 0; i < r->P.n; i++) cnt[r->P.kind[i] < 3 ? r->P.kind[i] : 0]++;
     char ps[256], vs[256];
@@ -104,8 +117,25 @@ static void print_header(const lubfoam_run *r)
                 r->step, m->dim);
     lub_message("Particles: %zu (fluid %zu, wall %zu, dummy %zu), threads %d", r->P.n, cnt[0],
                 cnt[1], cnt[2], omp_get_max_threads());
-    lub_message("MPS: l0 %g m, re %g m (%g l0), n0 %.10g, lambda0 %.10g m^2", m->l0, m->re,
-                m->c.re_l0, m->n0, m->lambda0);
+    if (r->opt) {
+        const lub_opt *o = r->opt;
+        char desc[1024];
+        lub_levels_describe(&o->L, desc, sizeof desc);
+        lub_message("multiResolution: %s", desc);
+        for (int k = 0; k < o->nlevels; k++) {
+            const lub_mps *q = &o->m[k];
+            size_t c[3] = {0, 0, 0};
+            for (size_t i = 0; i < o->P[k].n; i++) c[o->P[k].kind[i] < 3 ? o->P[k].kind[i] : 0]++;
+            lub_message("MPS level %d: l0 %g m, re %g m (%g l0), n0 %.10g, lambda0 %.10g m^2; "
+                        "%zu particles (fluid %zu, wall %zu, dummy %zu), %zu added in its "
+                        "overlap margins; %zu generation cells, room for %zu particles",
+                        k, q->l0, q->re, q->c.re_l0, q->n0, q->lambda0, o->P[k].n, c[0], c[1], c[2],
+                        o->filled[k], o->ngen[k], o->P[k].cap);
+        }
+    } else {
+        lub_message("MPS: l0 %g m, re %g m (%g l0), n0 %.10g, lambda0 %.10g m^2", m->l0, m->re,
+                    m->c.re_l0, m->n0, m->lambda0);
+    }
     lub_message("Schemes: gradient %s%s, gamma %g, alpha %g, surface beta %g, viscosity %s",
                 m->c.gradient == LUB_GRADIENT_LSMPS ? "lsmps" : "standard",
                 m->c.min_pressure_shift ? " (min-pressure shift)" : "", m->c.gamma, m->c.alpha,
@@ -152,6 +182,27 @@ static void log_line(const lubfoam_run *r, long steps_done, double wall0, double
     char eta[32], ew[128];
     format_hms(frac > 0 ? el * (1 - frac) / frac : NAN, eta, sizeof eta);
     elastic_summary(r, ew, sizeof ew);
+    if (r->opt) {
+        /* per level: pressure and viscosity iterations, surface and given (fixed-band)
+         * particles; fluid particles per level and the mass (T-27) against the start's */
+        const lub_opt *o = r->opt;
+        lub_opt_mass mc;
+        lub_opt_mass_count(o, &mc);
+        char lv[512];
+        size_t len = 0;
+        for (int k = 0; k < o->nlevels && len < sizeof lv; k++)
+            len += (size_t)snprintf(
+                lv + len, sizeof lv - len,
+                "%sL%d p %d U %d surf %zu given %zu fluid %zu (+%zu -%zu)", k ? " | " : "", k,
+                o->m[k].st.p.iterations, viscosity_iterations(&o->m[k]), o->m[k].st.nsurface,
+                o->st.nfixed[k], mc.fluid[k], o->total_generated[k], o->total_deleted[k]);
+        lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g %s  mass %+.3f%%  "
+                    "(p it per step, all levels: %.1f)  ETA %s",
+                    r->t, 100 * frac, r->step, r->dt, lub_opt_courant_per_dt(o, NULL) * r->dt, lv,
+                    r->mass0 > 0 ? 100 * (mc.mass / r->mass0 - 1) : 0.0,
+                    steps_done ? pit_sum / (double)steps_done : 0.0, eta);
+        return;
+    }
     lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g p %3d it %8.2e (mean %.1f)  "
                 "U %3d it  surf %-6zu ETA %s%s",
                 r->t, 100 * frac, r->step, r->dt, m->st.umax * r->dt / m->l0, m->st.p.iterations,
@@ -173,18 +224,32 @@ static void progress_bar(const lubfoam_run *r, long steps_done, double wall0)
     fflush(stdout);
 }
 
+/* Seconds spent in phase k (multi-resolution: summed over the levels). */
+static double phase_seconds(const lubfoam_run *r, int k)
+{
+    if (!r->opt) return r->mps.tm.seconds[k];
+    double s = 0;
+    for (int l = 0; l < r->opt->nlevels; l++) s += r->opt->m[l].tm.seconds[k];
+    return s;
+}
+
+/* The timers the solver's own work outside a step (output, coupling) is charged to. */
+static lub_timers *run_timers(lubfoam_run *r)
+{
+    return r->opt ? &r->opt->m[0].tm : &r->mps.tm;
+}
+
 /* Cost summary on the log and in postProcessing/cost/<startTime>/cost.dat. */
 static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, double vit_sum)
 {
-    const lub_mps *m = &r->mps;
     double ps = (double)r->P.n * (double)steps;
     double us = ps > 0 ? 1e6 * wall / ps : 0;
     lub_message("Cost: %ld steps, %zu particles, %.6g particle-steps in %.3f s wall: "
                 "%.4g us per particle-step (%d threads)",
                 steps, r->P.n, ps, wall, us, omp_get_max_threads());
     for (int k = 0; k < LUB_T_COUNT; k++)
-        lub_message("  %-16s %10.3f s  %5.1f%%", lub_mps_phase_names[k], m->tm.seconds[k],
-                    wall > 0 ? 100 * m->tm.seconds[k] / wall : 0.0);
+        lub_message("  %-16s %10.3f s  %5.1f%%", lub_mps_phase_names[k], phase_seconds(r, k),
+                    wall > 0 ? 100 * phase_seconds(r, k) / wall : 0.0);
     char path[LUB_PATH_MAX];
     lub_postproc_path(&r->cs, "cost", r->start_name, "cost.dat", path);
     lub_atomic_file af;
@@ -206,7 +271,7 @@ static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, 
                                         (double)omp_get_max_threads(),
                                         steps ? pit_sum / (double)steps : 0.0,
                                         steps ? vit_sum / (double)steps : 0.0};
-    for (int k = 0; k < LUB_T_COUNT; k++) row[NFIXED + k] = m->tm.seconds[k];
+    for (int k = 0; k < LUB_T_COUNT; k++) row[NFIXED + k] = phase_seconds(r, k);
     lub_table_write_row(fp, row, NFIXED + LUB_T_COUNT);
     if (lub_atomic_close(&af) != 0) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
 }
@@ -250,9 +315,26 @@ int main(int argc, char **argv)
         lub_fatal("the particles are %d-D but system/particleGenDict.yaml says dimension %d",
                   r.P.dim, geo.dim);
     lub_mps_config cfg;
-    lub_mps_config_read(&cfg, r.cs.root, &r.P);
-    lub_mps_init(&r.mps, &r.P, &cfg, geo.dmin, geo.dmax, geo.periodic);
-    lubfoam_read_elastic(&r, &geo);
+    lub_levels levels;
+    lub_mps_config_read(&cfg, r.cs.root, &r.P, &levels);
+    if (levels.nlevels > 0) {
+        /* multi-resolution: one solver per level (mps/opt.h); r.P keeps all levels, merged
+         * back after every step for the function objects and the time folders */
+        r.opt = lub_malloc(sizeof *r.opt);
+        lub_opt_init(r.opt, &levels, &r.P, &cfg, &geo, 0.5);
+        lub_particles_reserve(&r.P, lub_opt_capacity(r.opt));
+        lub_opt_merge(r.opt, &r.P);
+        lub_opt_mass m0;
+        lub_opt_mass_count(r.opt, &m0);
+        r.mass0 = m0.mass;
+        if (r.has_opt_state) { /* a restart: the ids and M^0 of the run it continues */
+            if (r.next_id > r.opt->next_id) r.opt->next_id = r.next_id;
+            if (r.state_mass0 > 0) r.mass0 = r.state_mass0;
+        }
+    } else {
+        lub_mps_init(&r.mps, &r.P, &cfg, geo.dmin, geo.dmax, geo.periodic);
+        lubfoam_read_elastic(&r, &geo);
+    }
     lub_geometry_free(&geo);
     lubfoam_functions *fos = lubfoam_functions_read(&r);
     lub_dict_finish(r.ctl.dict);
@@ -267,14 +349,23 @@ int main(int argc, char **argv)
     const long step0 = r.step;
     long steps = 0, last_write_step = -1;
     double pit_sum = 0, vit_sum = 0, last_bar = 0;
-    int warned_courant = 0, status = LUB_EXIT_OK;
+    int warned_courant = 0, warned_full = 0, status = LUB_EXIT_OK;
 
+    /* multi-resolution with sub-stepping: one pass of the loop is one step of the coarse level,
+     * nr steps of deltaT (dt below) on the fine level */
+    const int nr = r.opt ? r.opt->nr : 1;
     while (!lub_control_finished(&r.ctl, r.t, steps, r.dt)) {
-        if (r.ctl.adjust_time_step && r.mps.st.umax > 0) {
+        if (r.ctl.adjust_time_step && r.opt) {
+            /* every level takes dt: the largest u_max / l0 of the levels limits it */
+            double c = lub_opt_courant_per_dt(r.opt, NULL);
+            if (c > 0) r.dt = fmin(r.ctl.max_courant / c, r.ctl.delta_t);
+        } else if (r.ctl.adjust_time_step && r.mps.st.umax > 0) {
             double dtc = r.ctl.max_courant * r.mps.l0 / r.mps.st.umax;
             r.dt = dtc < r.ctl.delta_t ? dtc : r.ctl.delta_t;
         }
-        if (r.ctl.stop_at == LUB_STOP_ENDTIME && r.t + r.dt > r.ctl.end_time)
+        if (nr > 1 && r.ctl.stop_at == LUB_STOP_ENDTIME && r.t + nr * r.dt > r.ctl.end_time)
+            r.dt = (r.ctl.end_time - r.t) / nr; /* land on endTime exactly */
+        else if (r.ctl.stop_at == LUB_STOP_ENDTIME && r.t + r.dt > r.ctl.end_time)
             r.dt = r.ctl.end_time - r.t; /* land on endTime exactly */
         long bad = -1;
         char msg[1024];
@@ -293,40 +384,78 @@ int main(int argc, char **argv)
                 }
             }
         }
-        if (s == LUB_STEP_OK) s = lub_mps_step(&r.mps, r.dt, &bad, msg, sizeof msg);
+        if (s == LUB_STEP_OK && r.opt) {
+            int level;
+            s = lub_opt_step(r.opt, nr * r.dt, &level, &bad, msg, sizeof msg);
+        } else if (s == LUB_STEP_OK) {
+            s = lub_mps_step(&r.mps, r.dt, &bad, msg, sizeof msg);
+        }
         if (s != LUB_STEP_OK) {
             if (tty) fputc('\n', stdout);
             fflush(stdout);
-            fprintf(stderr, "lubFoam: error: step %ld (t = %.9g s): %s\n", r.step + 1, r.t + r.dt,
-                    msg);
+            fprintf(stderr, "lubFoam: error: step %ld (t = %.9g s): %s\n", r.step + nr,
+                    r.t + nr * r.dt, msg);
             fprintf(stderr, "lubFoam: the last good state is the newest time folder\n");
             status = LUB_EXIT_RUN;
             break;
         }
-        r.t += r.dt;
-        r.step++;
-        steps++;
+        if (nr > 1) {
+            r.t += nr * r.dt;
+            r.step += nr;
+            steps += nr;
+        } else {
+            r.t += r.dt;
+            r.step++;
+            steps++;
+        }
         if (r.has_elastic) lub_mps_elastic_after(&r.elastic, &r.mps, r.t);
-        pit_sum += r.mps.st.p.iterations;
-        vit_sum += viscosity_iterations(&r.mps);
-        double co = r.mps.st.umax * r.dt / r.mps.l0;
+        double co, umax;
+        if (r.opt) {
+            lub_timer_start(run_timers(&r), LUB_T_OTHER);
+            lub_opt_merge(r.opt, &r.P);
+            lub_timer_stop(run_timers(&r), LUB_T_OTHER);
+            int lv;
+            co = lub_opt_courant_per_dt(r.opt, &lv) * r.dt;
+            umax = r.opt->m[lv].st.umax;
+            pit_sum += (double)r.opt->st.piter; /* every level's every step */
+            vit_sum += (double)r.opt->st.viter;
+        } else {
+            pit_sum += r.mps.st.p.iterations;
+            vit_sum += viscosity_iterations(&r.mps);
+            co = r.mps.st.umax * r.dt / r.mps.l0;
+            umax = r.mps.st.umax;
+        }
         if (!r.ctl.adjust_time_step && co > r.ctl.max_courant && !warned_courant) {
             lub_warning("step %ld: Courant number %.3g exceeds maxCourant %g (u_max %g m/s)",
-                        r.step, co, r.ctl.max_courant, r.mps.st.umax);
+                        r.step, co, r.ctl.max_courant, umax);
             warned_courant = 1;
+        }
+        if (r.opt && r.opt->total_full > 0 && !warned_full) {
+            lub_warning("step %ld: multiResolution: a level's particle arrays are full (room "
+                        "allocated at the start): %zu particles could not be generated, so the "
+                        "fluid flowing into that level is lost",
+                        r.step, r.opt->total_full);
+            warned_full = 1;
         }
         lubfoam_functions_execute(fos, &r);
         int finished = lub_control_finished(&r.ctl, r.t, steps, r.dt);
-        if (lub_control_write_due(&r.ctl, r.start_time, r.t, step0, r.step, r.dt) || finished ||
-            stop_signal) {
-            lub_timer_start(&r.mps.tm, LUB_T_OUTPUT);
+        int due = 0; /* sub-stepping: a write due at any of the pass's fine steps */
+        for (int j = 0; j < nr && !due; j++)
+            due = lub_control_write_due(&r.ctl, r.start_time, r.t - j * r.dt, step0, r.step - j,
+                                        r.dt);
+        if (due || finished || stop_signal) {
+            lub_timer_start(run_timers(&r), LUB_T_OUTPUT);
             lubfoam_write(&r);
             lubfoam_functions_write(fos, &r);
             last_write_step = r.step;
-            lub_mps_rebuild_lists(&r.mps); /* exact restart from this folder */
-            lub_timer_stop(&r.mps.tm, LUB_T_OUTPUT);
+            /* exact restart from this folder */
+            if (r.opt)
+                lub_opt_rebuild_lists(r.opt);
+            else
+                lub_mps_rebuild_lists(&r.mps);
+            lub_timer_stop(run_timers(&r), LUB_T_OUTPUT);
         }
-        if (steps % r.ctl.log_interval == 0 || finished) {
+        if (steps / r.ctl.log_interval != (steps - nr) / r.ctl.log_interval || finished) {
             if (tty) fputc('\r', stdout);
             log_line(&r, steps, wall0, pit_sum);
         } else if (tty && lub_wtime() - last_bar > 0.2) {
@@ -349,7 +478,12 @@ int main(int argc, char **argv)
     }
     lubfoam_functions_free(fos);
     lub_mps_elastic_free(&r.elastic);
-    lub_mps_free(&r.mps);
+    if (r.opt) {
+        lub_opt_free(r.opt);
+        free(r.opt);
+    } else {
+        lub_mps_free(&r.mps);
+    }
     lub_particles_free(&r.P);
     lub_control_free(&r.ctl);
     free(r.written);

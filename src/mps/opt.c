@@ -1,0 +1,945 @@
+/* lubkit MPS: the overlapping particle technique, multi-resolution driver (see opt.h). */
+#include "mps/opt.h"
+
+#include <math.h>
+#include <omp.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "geometry/discretise.h"
+#include "mps/operators.h"
+#include "mps/weight.h"
+
+/* ---- particles: split, fill, merge ------------------------------------------------------ */
+
+/* Append particle i of src to dst (capacity reserved; extra fields in the same order). */
+static void copy_particle(lub_particles *dst, const lub_particles *src, size_t i)
+{
+    const size_t k = dst->n++;
+    for (int d = 0; d < 3; d++) {
+        dst->x[d][k] = src->x[d][i];
+        dst->u[d][k] = src->u[d][i];
+    }
+    dst->p[k] = src->p[i];
+    dst->kind[k] = src->kind[i];
+    dst->patch[k] = src->patch[i];
+    dst->level[k] = src->level[i];
+    dst->id[k] = src->id[i];
+    for (int e = 0; e < src->nextra; e++) dst->extra[e].v[k] = src->extra[e].v[i];
+}
+
+/* The margins of level k: the parts of its extended region it does not own, as closed
+ * intervals (a periodic one may reach past the domain's x; split by the caller). */
+static int margins(const lub_levels *L, int k, double iv[4][2])
+{
+    const lub_level_def *v = &L->level[k];
+    int n = 0;
+    if (k < L->nlevels - 1) { /* past its own region, into the coarser level's */
+        if (v->bounded[0]) iv[n][0] = v->ext[0], iv[n++][1] = v->region[0];
+        if (v->bounded[1]) iv[n][0] = v->region[1], iv[n++][1] = v->ext[1];
+    }
+    if (k > 0) { /* inside the finer level's region, up to its hole */
+        const lub_level_def *f = &L->level[k - 1];
+        if (f->bounded[0]) iv[n][0] = f->region[0], iv[n++][1] = v->hole[0];
+        if (f->bounded[1]) iv[n][0] = v->hole[1], iv[n++][1] = f->region[1];
+    }
+    return n;
+}
+
+/* x in the closed interval [a, b] (periodic: some image of x). */
+static int in_interval(const lub_levels *L, double x, double a, double b)
+{
+    if (!L->periodic) return x >= a && x <= b;
+    const double period = L->xmax - L->xmin;
+    const double y = a + fmod(x - a, period);
+    return (y >= a ? y : y + period) <= b;
+}
+
+/* Level k's particles that the geometry puts in its margins, when a margin holds none of
+ * the level's particles yet (a start from particleGen's file), into G (initialised here;
+ * fluid at rest).  The particles must lie in the level's extended region and outside the
+ * part of x it owns. */
+static void fill_margins(const lub_levels *L, const lub_geometry *g, const lub_particles *P, int k,
+                         lub_particles *G)
+{
+    lub_particles_init(G, g->dim, 16);
+    double iv[4][2];
+    const int n = margins(L, k, iv);
+    for (int m = 0; m < n; m++) {
+        int empty = 1;
+        for (size_t i = 0; i < P->n && empty; i++) {
+            if (P->level[i] != k) continue;
+            lub_level_where w;
+            lub_levels_locate(L, P->x[0][i], &w);
+            if (w.owner != k && in_interval(L, P->x[0][i], iv[m][0], iv[m][1])) empty = 0;
+        }
+        if (!empty) continue;
+        /* the interval in the domain's x: one piece, or two across a periodic seam */
+        double piece[2][2];
+        int np = 0;
+        const double period = L->xmax - L->xmin;
+        double a = iv[m][0], b = iv[m][1];
+        if (L->periodic && a < L->xmin) {
+            piece[np][0] = a + period, piece[np++][1] = L->xmax;
+            a = L->xmin;
+        }
+        if (L->periodic && b > L->xmax) {
+            piece[np][0] = L->xmin, piece[np++][1] = b - period;
+            b = L->xmax;
+        }
+        piece[np][0] = a, piece[np++][1] = b;
+        for (int q = 0; q < np; q++) {
+            if (!(piece[q][0] <= piece[q][1])) continue;
+            lub_particles R;
+            lub_geometry_discretise_range(g, k, piece[q][0], piece[q][1], &R);
+            for (size_t i = 0; i < R.n; i++) {
+                lub_level_where w;
+                lub_levels_locate(L, R.x[0][i], &w);
+                if (w.owner == k || !(w.present & (1u << k))) continue;
+                double x[3] = {R.x[0][i], R.x[1][i], R.x[2][i]};
+                int patch = 0;
+                if (R.kind[i] != LUB_FLUID) {
+                    patch = lub_particles_find_patch(P, R.patch_names[R.patch[i]]);
+                    if (patch < 0)
+                        lub_bug("fill_margins: no patch '%s'", R.patch_names[R.patch[i]]);
+                }
+                lub_particles_add(G, x, R.kind[i], patch, k);
+            }
+            lub_particles_free(&R);
+        }
+    }
+}
+
+/* The fill fraction of a level's fluid at its free surface: the PND of a half-space of the
+ * regular lattice (spacing 1, rows y <= 0, every lattice point) at half a spacing above its
+ * top row, over n0 (T-4).  The top row's particles represent the fluid up to there, so a
+ * point where the fraction n_fluid / (n0 - n_wall) exceeds this lies inside the fluid the
+ * level represents (0.601 in 2-D at re = 3.1 l0; 0.744 at 2.1, 0.558 at 4.0). */
+static double surface_fraction(int dim, double re_l0)
+{
+    const int m = (int)ceil(re_l0) + 1, mz = dim == 3 ? m : 0;
+    double n0, lambda0, s = 0.0;
+    lub_mps_reference(dim, 1.0, re_l0, &n0, &lambda0);
+    for (int c = -mz; c <= mz; c++)
+        for (int b = -m; b <= 0; b++)
+            for (int a = -m; a <= m; a++) {
+                const double y = b - 0.5;
+                s += lub_mps_weight(sqrt((double)a * a + y * y + (double)c * c), re_l0);
+            }
+    return s / n0;
+}
+
+/* The generation cells of level k (opt.h, lub_opt_transfer): the level's lattice points in
+ * its generation layers, one l0 wide inside each edge of its extended region beyond which
+ * another level lies (locate's `generate`), where particleGen's rules allow fluid. */
+static void generation_cells(lub_opt *o, const lub_geometry *g, int k)
+{
+    const lub_levels *L = &o->L;
+    const lub_level_def *v = &L->level[k];
+    const double l0 = v->l0, eps = 1e-6 * l0;
+    double iv[4][2];
+    int n = 0;
+    if (k < L->nlevels - 1) {
+        if (v->bounded[0]) iv[n][0] = v->ext[0], iv[n++][1] = v->ext[0] + l0 - eps;
+        if (v->bounded[1]) iv[n][0] = v->ext[1] - l0 + eps, iv[n++][1] = v->ext[1];
+    }
+    if (k > 0 && v->has_hole) {
+        if (isfinite(v->hole[0])) iv[n][0] = v->hole[0] - l0 + eps, iv[n++][1] = v->hole[0];
+        if (isfinite(v->hole[1])) iv[n][0] = v->hole[1], iv[n++][1] = v->hole[1] + l0 - eps;
+    }
+    /* the geometry with one fluid region, the whole domain: fluid wherever it may be */
+    lub_geometry any = *g;
+    lub_region box;
+    memset(&box, 0, sizeof box);
+    box.type = LUB_REGION_BOX;
+    for (int d = 0; d < 3; d++) box.min[d] = g->dmin[d], box.max[d] = g->dmax[d];
+    any.nregions = 1;
+    any.regions = &box;
+    size_t cap = 0;
+    for (int m = 0; m < n; m++) {
+        lub_particles R;
+        lub_geometry_discretise_range(&any, k, iv[m][0], iv[m][1], &R);
+        for (size_t i = 0; i < R.n; i++) {
+            if (R.kind[i] != LUB_FLUID) continue;
+            if (o->ngen[k] == cap) {
+                cap = cap ? 2 * cap : 64;
+                o->gen[k] = lub_realloc(o->gen[k], 3 * cap * sizeof(double));
+            }
+            for (int d = 0; d < 3; d++) o->gen[k][3 * o->ngen[k] + d] = R.x[d][i];
+            o->ngen[k]++;
+        }
+        lub_particles_free(&R);
+    }
+    const size_t m = o->ngen[k] ? o->ngen[k] : 1;
+    o->gen_ok[k] = lub_calloc(m, 1);
+    o->gen_val[k] = lub_calloc(7 * m, sizeof(double));
+}
+
+/* Every moving wall must be a plane sliding along itself (opt.h, Walls). */
+static void check_walls(const lub_particles *P, const lub_mps_config *c, const lub_geometry *g)
+{
+    for (int p = 0; p < P->npatches; p++) {
+        const double *v = c->patch_velocity[p];
+        const lub_wall *w = NULL;
+        for (int i = 0; i < g->nwalls; i++)
+            if (strcmp(g->walls[i].name, P->patch_names[p]) == 0) w = &g->walls[i];
+        if (c->patch_moved[p])
+            lub_fatal("multiResolution: the wall '%s' is moved by a model (elasticWall): a "
+                      "multi-resolution run does not support it yet",
+                      P->patch_names[p]);
+        const double s = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        if (!(s > 0)) continue;
+        double vn = 0;
+        if (w)
+            for (int d = 0; d < 3; d++) vn += v[d] * w->normal[d];
+        if (!w || w->type != LUB_WALL_PLANE || w->has_range || fabs(vn) > 1e-9 * s) {
+            const char *why = !w                          ? "is not a wall of the geometry"
+                              : w->type != LUB_WALL_PLANE ? "is not a plane"
+                              : w->has_range              ? "is a plane with a range in x"
+                                                          : "moves across its normal";
+            if (w)
+                lub_node_error(w->node,
+                               "multiResolution: the wall '%s' moves (movingWalls velocity %g, "
+                               "%g) but %s: in a multi-resolution run the wall particles keep "
+                               "their positions and only carry the velocity, which is right "
+                               "for a plane without ends sliding along itself only",
+                               P->patch_names[p], v[0], v[1], why);
+            lub_fatal("multiResolution: the moving wall '%s' %s", P->patch_names[p], why);
+        }
+    }
+}
+
+void lub_opt_init(lub_opt *o, const lub_levels *L, const lub_particles *P, const lub_mps_config *c,
+                  const lub_geometry *g, double headroom)
+{
+    memset(o, 0, sizeof *o);
+    o->L = *L;
+    o->nlevels = L->nlevels;
+    o->dim = P->dim;
+    if (P->nlevels != L->nlevels)
+        lub_bug("lub_opt_init: particles with %d levels, %d in the levels", P->nlevels, L->nlevels);
+    check_walls(P, c, g);
+    uint64_t next = 0;
+    for (size_t i = 0; i < P->n; i++)
+        if (P->id[i] >= next) next = P->id[i] + 1;
+
+    for (int k = 0; k < o->nlevels - 1; k++) {
+        const lub_level_def *v = &L->level[k];
+        if (L->periodic && (v->ext[0] < L->xmin || v->ext[1] > L->xmax))
+            lub_fatal("multiResolution: level %d's extended region [%g, %g] (its region and the "
+                      "overlap margins) reaches across the periodic seam of x [%g, %g]: shift "
+                      "the domain (or the region) so that it lies inside",
+                      k, v->ext[0], v->ext[1], L->xmin, L->xmax);
+    }
+
+    lub_mps_config cfg = *c;
+    cfg.fixed_flags = 1;
+    cfg.still_walls = 1;
+    for (int k = 0; k < o->nlevels; k++) {
+        lub_particles G;
+        fill_margins(L, g, P, k, &G);
+        generation_cells(o, g, k);
+        o->fill[k] = surface_fraction(o->dim, c->re_l0);
+        size_t cnt = 0;
+        for (size_t i = 0; i < P->n; i++) cnt += P->level[i] == k;
+        /* room for the particles generated later: headroom, and 4 per generation cell (a
+         * level that starts nearly empty and fills up through its generation layers) */
+        const size_t total = cnt + G.n + 4 * o->ngen[k];
+        lub_particles *Q = &o->P[k];
+        lub_particles_init(Q, P->dim, (size_t)((double)total * (1.0 + headroom)) + 16);
+        Q->time = P->time;
+        Q->step = P->step;
+        Q->nlevels = 1;
+        Q->levels[0] = P->levels[k];
+        Q->npatches = P->npatches;
+        memcpy(Q->patch_names, P->patch_names, sizeof Q->patch_names);
+        for (int e = 0; e < P->nextra; e++) lub_particles_extra(Q, P->extra[e].name);
+        for (size_t i = 0; i < P->n; i++)
+            if (P->level[i] == k) copy_particle(Q, P, i);
+        for (size_t i = 0; i < G.n; i++) {
+            const size_t j = Q->n++;
+            for (int d = 0; d < 3; d++) Q->x[d][j] = G.x[d][i], Q->u[d][j] = 0.0;
+            Q->p[j] = 0.0;
+            Q->kind[j] = G.kind[i];
+            Q->patch[j] = G.patch[i];
+            Q->level[j] = (uint8_t)k;
+            Q->id[j] = next++;
+            for (int e = 0; e < Q->nextra; e++) Q->extra[e].v[j] = 0.0;
+        }
+        o->filled[k] = G.n;
+        lub_particles_free(&G);
+        if (cnt == 0)
+            lub_fatal("multiResolution: level %d (l0 %g) has no particles in the particle file", k,
+                      P->levels[k].l0);
+        lub_mps_init(&o->m[k], Q, &cfg, g->dmin, g->dmax, g->periodic);
+        /* the neighbour search's particle arrays sized once for the capacity */
+        lub_neighbours_bin(&o->m[k].nb, Q->cap, Q->x);
+
+        /* cell list of the level as a source, sized once for its capacity */
+        lub_neighbours_init(&o->src[k], o->dim, o->m[k].re, 0.0, g->dmin, g->dmax, g->periodic);
+        lub_neighbours_bin(&o->src[k], Q->cap, Q->x);
+        lub_lsq_options *s = &o->lsq[k];
+        *s = lub_lsq_defaults(o->dim, o->m[k].l0, o->m[k].re);
+        s->order = 2;
+        for (int d = 0; d < o->dim; d++)
+            s->period[d] = g->periodic[d] ? g->dmax[d] - g->dmin[d] : 0.0;
+        if (Q->cap > o->cap_cand) o->cap_cand = Q->cap;
+    }
+    /* each level's step count (the reorder schedule of lub_mps_step) in its own steps: the
+     * particle file counts the finest level's */
+    for (int k = 0; k < o->nlevels; k++) o->m[k].steps = P->step / L->level[k].dt_factor;
+    o->nr = L->common_dt ? 1 : L->level[0].nr;
+    if (o->nr > 1) {
+        if (o->nlevels != 2) lub_bug("lub_opt_init: sub-stepping with %d levels", o->nlevels);
+        const lub_particles *C = &o->P[1];
+        lub_particles_init(&o->PK, o->dim, C->cap);
+        o->fixK = lub_calloc(C->cap, 1);
+        lub_neighbours_init(&o->srcK, o->dim, o->m[1].re, 0.0, g->dmin, g->dmax, g->periodic);
+        lub_neighbours_bin(&o->srcK, C->cap, o->PK.x);
+    }
+    o->next_id = next;
+    o->nthreads = omp_get_max_threads();
+    o->cand = lub_malloc((size_t)o->nthreads * o->cap_cand * sizeof *o->cand);
+}
+
+void lub_opt_free(lub_opt *o)
+{
+    for (int k = 0; k < o->nlevels; k++) {
+        lub_mps_free(&o->m[k]);
+        lub_neighbours_free(&o->src[k]);
+        lub_particles_free(&o->P[k]);
+    }
+    for (int k = 0; k < LUB_MAX_LEVELS; k++) {
+        free(o->gen[k]);
+        free(o->gen_ok[k]);
+        free(o->gen_val[k]);
+    }
+    if (o->nr > 1) {
+        lub_particles_free(&o->PK);
+        free(o->fixK);
+        lub_neighbours_free(&o->srcK);
+    }
+    free(o->cand);
+    memset(o, 0, sizeof *o);
+}
+
+size_t lub_opt_capacity(const lub_opt *o)
+{
+    size_t c = 0;
+    for (int k = 0; k < o->nlevels; k++) c += o->P[k].cap;
+    return c;
+}
+
+void lub_opt_merge(const lub_opt *o, lub_particles *P)
+{
+    size_t n = 0;
+    for (int k = 0; k < o->nlevels; k++) n += o->P[k].n;
+    lub_particles_reserve(P, n);
+    P->npatches = o->P[0].npatches;
+    memcpy(P->patch_names, o->P[0].patch_names, sizeof P->patch_names);
+    P->nlevels = o->nlevels;
+    P->n = 0;
+    for (int k = 0; k < o->nlevels; k++) {
+        const lub_particles *Q = &o->P[k];
+        P->levels[k] = Q->levels[0];
+        double *ev[LUB_MAX_EXTRA];
+        for (int e = 0; e < Q->nextra; e++) ev[e] = lub_particles_extra(P, Q->extra[e].name);
+        const size_t base = P->n;
+        for (int d = 0; d < 3; d++) {
+            memcpy(P->x[d] + base, Q->x[d], Q->n * sizeof(double));
+            memcpy(P->u[d] + base, Q->u[d], Q->n * sizeof(double));
+        }
+        memcpy(P->p + base, Q->p, Q->n * sizeof *P->p);
+        memcpy(P->kind + base, Q->kind, Q->n * sizeof *P->kind);
+        memcpy(P->patch + base, Q->patch, Q->n * sizeof *P->patch);
+        memcpy(P->level + base, Q->level, Q->n * sizeof *P->level);
+        memcpy(P->id + base, Q->id, Q->n * sizeof *P->id);
+        for (int e = 0; e < Q->nextra; e++)
+            memcpy(ev[e] + base, Q->extra[e].v, Q->n * sizeof(double));
+        P->n += Q->n;
+    }
+}
+
+/* ---- the coupling: fixed bands by least squares ------------------------------------------ */
+
+/* Mark the particles of level k whose values are given this step: fluid and wall particles
+ * in a fixed band (T-25, T-26) or outside the level's extended region. */
+static size_t mark_fixed(lub_opt *o, int k)
+{
+    lub_particles *P = &o->P[k];
+    uint8_t *fix = o->m[k].fixed;
+    const unsigned bit = 1u << k;
+    size_t nfix = 0;
+#pragma omp parallel for schedule(static) reduction(+ : nfix)
+    for (size_t i = 0; i < P->n; i++) {
+        uint8_t f = 0;
+        if (P->kind[i] != LUB_DUMMY) {
+            lub_level_where w;
+            lub_levels_locate(&o->L, P->x[0][i], &w);
+            f = (w.fixed & bit) || !(w.present & bit);
+        }
+        fix[i] = f;
+        nfix += f;
+    }
+    return nfix;
+}
+
+/* The level whose particles give the values of a particle of level k at x: the other level
+ * of the overlap x lies in, else the level owning x, else a neighbouring level. */
+static int source_level(const lub_opt *o, int k, double x)
+{
+    lub_level_where w;
+    lub_levels_locate(&o->L, x, &w);
+    if (w.boundary >= 0) {
+        const lub_level_boundary *b = &o->L.boundary[w.boundary];
+        if (b->fine == k) return b->coarse;
+        if (b->coarse == k) return b->fine;
+    }
+    if (w.owner != k) return w.owner;
+    return k > 0 ? k - 1 : k + 1;
+}
+
+/* Cell coordinate of x in direction d of a cell list (clamped; as neighbours.c). */
+static int cell_of(const lub_neighbours *nb, int d, double x)
+{
+    if (nb->periodic[d]) {
+        x = nb->lo[d] + fmod(x - nb->lo[d], nb->period[d]);
+        if (x < nb->lo[d]) x += nb->period[d];
+    }
+    const double t = (x - nb->lo[d]) * nb->inv_h[d];
+    if (!(t >= 0)) return 0;
+    if (t >= nb->nc[d]) return nb->nc[d] - 1;
+    return (int)t;
+}
+
+/* The cells of a cell list around x: cells[d][0 .. nc[d]) in direction d, up to 3 (fewer at
+ * a non-periodic end, or when a period holds fewer than 3 cells). */
+static void cells_around(const lub_neighbours *nb, int dim, const double x[3], int cells[3][3],
+                         int nc[3])
+{
+    for (int d = 0; d < 3; d++) {
+        nc[d] = 0;
+        if (d >= dim) {
+            cells[d][nc[d]++] = 0;
+            continue;
+        }
+        const int c = cell_of(nb, d, x[d]);
+        for (int off = -1; off <= 1; off++) {
+            int cc = c + off;
+            if (nb->periodic[d])
+                cc = (cc + nb->nc[d]) % nb->nc[d];
+            else if (cc < 0 || cc >= nb->nc[d])
+                continue;
+            int seen = 0;
+            for (int q = 0; q < nc[d]; q++) seen |= cells[d][q] == cc;
+            if (!seen) cells[d][nc[d]++] = cc;
+        }
+    }
+}
+
+/* Index of cell (a, b, e) of a cell list (as neighbours.c: x fastest). */
+static inline size_t cell_index(const lub_neighbours *nb, int a, int b, int e)
+{
+    return (size_t)a + (size_t)nb->nc[0] * ((size_t)b + (size_t)nb->nc[1] * (size_t)e);
+}
+
+/* A source of interpolated values: a level's particles now, or (sub-stepping) the coarser
+ * level as it was at the start of its step, state K of T-20..T-22. */
+typedef struct {
+    const lub_particles *P;
+    const uint8_t *fixed;
+    const lub_neighbours *cells; /* binned at P's positions */
+    const lub_lsq_options *lsq;
+    double re, n0, fill;
+} source;
+
+static source source_now(const lub_opt *o, int k)
+{
+    source s = {&o->P[k],   o->m[k].fixed, &o->src[k], &o->lsq[k],
+                o->m[k].re, o->m[k].n0,    o->fill[k]};
+    return s;
+}
+
+/* Values at a time between the states old (K) and now (K + 1) of the source level:
+ * w old + (1 - w) now, w the weight of T-20..T-22 (corrected; lub_levels_time_weight);
+ * old NULL: now alone. */
+typedef struct {
+    const source *old, *now;
+    double w;
+} blend;
+
+/* The source particles in the cells around x (the cells are at least re wide, so every
+ * particle within re is among them): fluid and wall particles, without those given
+ * themselves when skip_fixed. */
+static size_t gather(const lub_opt *o, const source *S, const double x[3], int skip_fixed,
+                     size_t *out)
+{
+    const lub_neighbours *nb = S->cells;
+    const lub_particles *P = S->P;
+    const uint8_t *fix = S->fixed;
+    int cells[3][3], nc[3];
+    cells_around(nb, o->dim, x, cells, nc);
+    size_t n = 0;
+    for (int a = 0; a < nc[0]; a++)
+        for (int b = 0; b < nc[1]; b++)
+            for (int e = 0; e < nc[2]; e++) {
+                const size_t cell = cell_index(nb, cells[0][a], cells[1][b], cells[2][e]);
+                for (size_t q = nb->cell_start[cell]; q < nb->cell_start[cell + 1]; q++) {
+                    const size_t j = nb->perm[q];
+                    if (P->kind[j] != LUB_DUMMY && !(skip_fixed && fix[j])) out[n++] = j;
+                }
+            }
+    return n;
+}
+
+/* Least-squares fit (lsq.h) at x of the velocity (when fluid) and pressure of one source:
+ * v = {u (dim), p}, grad (may be NULL) their gradients.
+ *
+ * Limiter.  Where x lies beyond the source's particles (a band particle above the other
+ * level's free surface, which is lower by up to half a coarse spacing, or past its wall
+ * layer) the fit extrapolates, and a second-order fit can overshoot by far (measured: 2.7 m/s
+ * in a film on a wall sliding at 1 m/s, on a coarse level of four rows).  Each value is
+ * therefore kept within the range of the neighbours' values (within re), widened by a quarter
+ * of that range on each side: a smooth field inside the neighbourhood (the peak of a
+ * Poiseuille profile between two rows) is not clipped, an extrapolation is. */
+static lub_lsq_result fit_one(const lub_opt *o, const source *S, const double x[3], int fluid,
+                              int skip_fixed, size_t *cand, double v[4], double (*grad)[3])
+{
+    const size_t n = gather(o, S, x, skip_fixed, cand);
+    const double *const xs[3] = {S->P->x[0], S->P->x[1], S->P->x[2]};
+    const double *f[4];
+    int nf = 0;
+    if (fluid)
+        for (int d = 0; d < o->dim; d++) f[nf++] = S->P->u[d];
+    f[nf++] = S->P->p;
+    lub_lsq_result r = lub_lsq_interpolate(S->lsq, x, xs, n, cand, nf, f, v, grad, NULL);
+    if (r.status == LUB_LSQ_EMPTY) return r;
+    double lo[4], hi[4];
+    for (int k = 0; k < nf; k++) lo[k] = INFINITY, hi[k] = -INFINITY;
+    const double re2 = S->re * S->re;
+    for (size_t q = 0; q < n; q++) {
+        const size_t j = cand[q];
+        double r2 = 0;
+        for (int d = 0; d < o->dim; d++) {
+            const double c = lub_min_image(xs[d][j] - x[d], S->lsq->period[d]);
+            r2 += c * c;
+        }
+        if (!(r2 < re2)) continue;
+        for (int k = 0; k < nf; k++) {
+            lo[k] = fmin(lo[k], f[k][j]);
+            hi[k] = fmax(hi[k], f[k][j]);
+        }
+    }
+    for (int k = 0; k < nf; k++) {
+        const double m = 0.25 * (hi[k] - lo[k]);
+        v[k] = fmin(fmax(v[k], lo[k] - m), hi[k] + m);
+    }
+    return r;
+}
+
+/* The same in time between two states (blend); the order is the lower of the two fits, the
+ * status EMPTY when either is. */
+static lub_lsq_result fit(const lub_opt *o, const blend *b, const double x[3], int fluid,
+                          int skip_fixed, size_t *cand, double v[4], double (*grad)[3])
+{
+    const source *only = !b->old || b->w <= 0 ? b->now : b->w >= 1 ? b->old : NULL;
+    if (only) return fit_one(o, only, x, fluid, skip_fixed, cand, v, grad);
+    double v0[4], g0[4][3];
+    lub_lsq_result r0 = fit_one(o, b->old, x, fluid, skip_fixed, cand, v0, g0);
+    lub_lsq_result r1 = fit_one(o, b->now, x, fluid, skip_fixed, cand, v, grad);
+    if (r0.status == LUB_LSQ_EMPTY) return r0;
+    if (r1.status == LUB_LSQ_EMPTY) return r1;
+    const int nf = fluid ? o->dim + 1 : 1;
+    for (int k = 0; k < nf; k++) {
+        v[k] = b->w * v0[k] + (1 - b->w) * v[k];
+        if (grad)
+            for (int d = 0; d < 3; d++) grad[k][d] = b->w * g0[k][d] + (1 - b->w) * grad[k][d];
+    }
+    if (r0.order < r1.order) r1.order = r0.order;
+    return r1;
+}
+
+/* The blend level A's values at x come from: the source level (source_level) now, or in
+ * time between old and now when old is that level's saved state. */
+static blend blend_for(const lub_opt *o, int A, double x, const source *now, const source *old,
+                       int old_level, double w)
+{
+    const int B = source_level(o, A, x);
+    blend b = {B == old_level ? old : NULL, &now[B], w};
+    return b;
+}
+
+/* Interpolate the fixed particles of level A (marked) from their source levels. */
+static void couple_level(lub_opt *o, int A, const source *now, const source *old, int old_level,
+                         double w)
+{
+    lub_particles *P = &o->P[A];
+    const uint8_t *fix = o->m[A].fixed;
+    const int dim = o->dim;
+    size_t nlower = 0, nempty = 0;
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : nlower, nempty)
+    for (size_t i = 0; i < P->n; i++) {
+        if (!fix[i]) continue;
+        size_t *cand = o->cand + (size_t)omp_get_thread_num() * o->cap_cand;
+        const double xt[3] = {P->x[0][i], P->x[1][i], P->x[2][i]};
+        const blend b = blend_for(o, A, xt[0], now, old, old_level, w);
+        /* fluid: velocity and pressure; wall: pressure (its velocity is its patch's) */
+        const int fluid = P->kind[i] == LUB_FLUID;
+        double v[4];
+        lub_lsq_result r = fit(o, &b, xt, fluid, 1, cand, v, NULL);
+        if (r.status == LUB_LSQ_EMPTY) {
+            nempty++;
+            continue;
+        }
+        if (r.order < 2) nlower++;
+        int nf = 0;
+        if (fluid)
+            for (int d = 0; d < dim; d++) P->u[d][i] = v[nf++];
+        P->p[i] = v[nf];
+    }
+    o->st.nlower += nlower;
+    o->st.nempty += nempty;
+}
+
+void lub_opt_couple(lub_opt *o)
+{
+    o->st.nlower = o->st.nempty = 0;
+    for (int k = 0; k < o->nlevels; k++) o->st.nfixed[k] = mark_fixed(o, k);
+    for (int k = 0; k < o->nlevels; k++) lub_neighbours_bin(&o->src[k], o->P[k].n, o->P[k].x);
+    source now[LUB_MAX_LEVELS];
+    for (int k = 0; k < o->nlevels; k++) now[k] = source_now(o, k);
+    for (int k = 0; k < o->nlevels; k++) couple_level(o, k, now, NULL, -1, 0.0);
+}
+
+/* ---- particle transfer ------------------------------------------------------------------- */
+
+/* Delete level k's fluid particles outside its extended region (stable: the others keep
+ * their order); returns the count. */
+static size_t delete_outside(lub_opt *o, int k)
+{
+    lub_particles *P = &o->P[k];
+    uint8_t *fix = o->m[k].fixed;
+    const unsigned bit = 1u << k;
+    size_t w = 0;
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->kind[i] == LUB_FLUID) {
+            lub_level_where lw;
+            lub_levels_locate(&o->L, P->x[0][i], &lw);
+            if (!(lw.present & bit)) continue;
+        }
+        if (w != i) {
+            for (int d = 0; d < 3; d++) {
+                P->x[d][w] = P->x[d][i];
+                P->u[d][w] = P->u[d][i];
+            }
+            P->p[w] = P->p[i];
+            P->kind[w] = P->kind[i];
+            P->patch[w] = P->patch[i];
+            P->level[w] = P->level[i];
+            P->id[w] = P->id[i];
+            for (int e = 0; e < P->nextra; e++) P->extra[e].v[w] = P->extra[e].v[i];
+            fix[w] = fix[i];
+        }
+        w++;
+    }
+    const size_t deleted = P->n - w;
+    P->n = w;
+    return deleted;
+}
+
+/* Whether a particle of level A is to be created at generation cell c (see lub_opt_transfer);
+ * val receives its u (3), p and grad p (3) interpolated from the other level (b). */
+static int decide(lub_opt *o, int A, const double c[3], double dt, const blend *bl, size_t *cand,
+                  double val[7])
+{
+    const int dim = o->dim;
+    const double l0 = o->m[A].l0;
+    double period[3] = {0, 0, 0};
+    for (int d = 0; d < dim; d++) period[d] = o->lsq[A].period[d];
+    int cells[3][3], nc[3];
+
+    /* nearest particle of A: leave the cell alone while one is within half a cell */
+    const lub_neighbours *na = &o->src[A];
+    const lub_particles *PA = &o->P[A];
+    double d2min = INFINITY;
+    cells_around(na, dim, c, cells, nc);
+    for (int a = 0; a < nc[0]; a++)
+        for (int b = 0; b < nc[1]; b++)
+            for (int e = 0; e < nc[2]; e++) {
+                const size_t cell = cell_index(na, cells[0][a], cells[1][b], cells[2][e]);
+                for (size_t q = na->cell_start[cell]; q < na->cell_start[cell + 1]; q++) {
+                    const size_t j = na->perm[q];
+                    double r2 = 0;
+                    for (int d = 0; d < dim; d++) {
+                        const double v = lub_min_image(PA->x[d][j] - c[d], period[d]);
+                        r2 += v * v;
+                    }
+                    if (r2 < d2min) d2min = r2;
+                }
+            }
+    if (d2min < 0.25 * l0 * l0) return 0;
+
+    /* the other level's fluid fills the cell: PND of its fluid against the room its walls
+     * leave (T-4 sums at c), in the state nearer in time */
+    const source *S = bl->old && bl->w >= 0.5 ? bl->old : bl->now;
+    const lub_neighbours *nb = S->cells;
+    const lub_particles *PB = S->P;
+    const double re = S->re, n0 = S->n0;
+    double nf = 0, nw = 0;
+    cells_around(nb, dim, c, cells, nc);
+    for (int a = 0; a < nc[0]; a++)
+        for (int b = 0; b < nc[1]; b++)
+            for (int e = 0; e < nc[2]; e++) {
+                const size_t cell = cell_index(nb, cells[0][a], cells[1][b], cells[2][e]);
+                for (size_t q = nb->cell_start[cell]; q < nb->cell_start[cell + 1]; q++) {
+                    const size_t j = nb->perm[q];
+                    double r2 = 0;
+                    for (int d = 0; d < dim; d++) {
+                        const double v = lub_min_image(PB->x[d][j] - c[d], period[d]);
+                        r2 += v * v;
+                    }
+                    if (!(r2 < re * re)) continue;
+                    const double w = lub_mps_weight(sqrt(r2), re);
+                    if (PB->kind[j] == LUB_FLUID)
+                        nf += w;
+                    else
+                        nw += w;
+                }
+            }
+    const double room = n0 - nw;
+    if (!(room > 0.1 * n0) || !(nf > S->fill * room)) return 0;
+
+    /* velocity, pressure and pressure gradient by least squares from B */
+    double v[4], grad[4][3];
+    lub_lsq_result r = fit(o, bl, c, 1, 0, cand, v, grad);
+    if (r.status == LUB_LSQ_EMPTY) return 0;
+    double speed = 0;
+    for (int d = 0; d < dim; d++) speed += v[d] * v[d];
+    speed = sqrt(speed);
+    /* created once the last particle is l0 - |u| dt / 2 away: spacing l0 on average */
+    const double rgen = fmax(0.5 * l0, l0 - 0.5 * speed * dt);
+    if (d2min < rgen * rgen) return 0;
+    for (int k = 0; k < 7; k++) val[k] = 0;
+    for (int d = 0; d < dim; d++) val[d] = v[d];
+    val[3] = v[dim];
+    for (int d = 0; d < dim; d++) val[4 + d] = grad[dim][d];
+    return 1;
+}
+
+/* Generation in level A's cells (A's and its sources' cell lists binned), after its step of
+ * length dt; values from now[] or, for old_level, in time between old and now (w). */
+static void generate(lub_opt *o, int A, double dt, const source *now, const source *old,
+                     int old_level, double w)
+{
+    static const char *const gnames[3] = {"gradPx", "gradPy", "gradPz"};
+    const size_t ng = o->ngen[A];
+    uint8_t *ok = o->gen_ok[A];
+    double *val = o->gen_val[A];
+#pragma omp parallel for schedule(dynamic, 16)
+    for (size_t q = 0; q < ng; q++) {
+        size_t *cand = o->cand + (size_t)omp_get_thread_num() * o->cap_cand;
+        const double *c = o->gen[A] + 3 * q;
+        const blend b = blend_for(o, A, c[0], now, old, old_level, w);
+        ok[q] = (uint8_t)decide(o, A, c, dt, &b, cand, val + 7 * q);
+    }
+    /* append in cell order (the same on any number of threads) */
+    lub_particles *P = &o->P[A];
+    double *gb[3];
+    for (int d = 0; d < 3; d++) gb[d] = lub_particles_find_extra(P, gnames[d]);
+    for (size_t q = 0; q < ng; q++) {
+        if (!ok[q]) continue;
+        if (P->n >= P->cap) {
+            o->st.nfull++;
+            continue;
+        }
+        const size_t j = P->n++;
+        const double *v = val + 7 * q;
+        for (int d = 0; d < 3; d++) {
+            P->x[d][j] = o->gen[A][3 * q + d];
+            P->u[d][j] = d < o->dim ? v[d] : 0.0;
+        }
+        P->p[j] = v[3];
+        P->kind[j] = LUB_FLUID;
+        P->patch[j] = 0;
+        P->level[j] = (uint8_t)A;
+        P->id[j] = o->next_id++;
+        for (int e = 0; e < P->nextra; e++) P->extra[e].v[j] = 0.0;
+        for (int d = 0; d < o->dim; d++)
+            if (gb[d]) gb[d][j] = v[4 + d];
+        o->m[A].fixed[j] = 1; /* it starts in the fixed band */
+        o->st.ngenerated[A]++;
+    }
+}
+
+/* Totals of a level's transfer; its lists are built afresh when its particles changed. */
+static void transfer_done(lub_opt *o, int k)
+{
+    o->total_deleted[k] += o->st.ndeleted[k];
+    o->total_generated[k] += o->st.ngenerated[k];
+    if (o->st.ndeleted[k] || o->st.ngenerated[k]) lub_mps_rebuild_lists(&o->m[k]);
+}
+
+void lub_opt_transfer(lub_opt *o, double dt)
+{
+    for (int k = 0; k < o->nlevels; k++) {
+        o->st.ndeleted[k] = delete_outside(o, k);
+        o->st.ngenerated[k] = 0;
+    }
+    for (int k = 0; k < o->nlevels; k++) lub_neighbours_bin(&o->src[k], o->P[k].n, o->P[k].x);
+    o->st.nfull = 0;
+    source now[LUB_MAX_LEVELS];
+    for (int k = 0; k < o->nlevels; k++) now[k] = source_now(o, k);
+    for (int A = 0; A < o->nlevels; A++) generate(o, A, dt, now, NULL, -1, 0.0);
+    for (int k = 0; k < o->nlevels; k++) transfer_done(o, k);
+    o->total_full += o->st.nfull;
+}
+
+/* ---- the step ---------------------------------------------------------------------------- */
+
+static lub_step_status step_level(lub_opt *o, int k, double dt, int *level, long *bad, char *msg,
+                                  size_t msgsize)
+{
+    char m[1024];
+    lub_step_status s = lub_mps_step(&o->m[k], dt, bad, m, sizeof m);
+    o->st.piter += o->m[k].st.p.iterations;
+    for (int d = 0; d < o->dim; d++) o->st.viter += o->m[k].st.v[d].iterations;
+    if (s != LUB_STEP_OK) {
+        *level = k;
+        snprintf(msg, msgsize, "level %d (l0 %g): %s", k, o->m[k].l0, m);
+    }
+    return s;
+}
+
+/* Save the coarse level's state K (the source of the fine level's sub-steps) and bin it. */
+static void save_coarse(lub_opt *o)
+{
+    const int c = o->nlevels - 1;
+    const lub_particles *P = &o->P[c];
+    lub_particles *K = &o->PK;
+    K->n = P->n;
+    for (int d = 0; d < 3; d++) {
+        memcpy(K->x[d], P->x[d], P->n * sizeof(double));
+        memcpy(K->u[d], P->u[d], P->n * sizeof(double));
+    }
+    memcpy(K->p, P->p, P->n * sizeof(double));
+    memcpy(K->kind, P->kind, P->n * sizeof *P->kind);
+    memcpy(o->fixK, o->m[c].fixed, P->n);
+    lub_neighbours_bin(&o->srcK, K->n, K->x);
+}
+
+/* One step of the coarse level (dt_coarse = Nr dt_fine, T-19) and Nr sub-steps of the fine
+ * level, the fine level's bands and generation fed by the coarse values interpolated in time
+ * between its states K and K + 1 (T-20..T-22 with the corrected weights; the thesis'
+ * Fig. 3 order: the coarse level first, with the fine values at K). */
+static lub_step_status substeps(lub_opt *o, double dt, int *level, long *bad, char *msg,
+                                size_t msgsize)
+{
+    const int F = 0, C = 1, nr = o->nr;
+    const double dtf = dt / nr;
+    lub_step_status s;
+    source now[LUB_MAX_LEVELS];
+    /* the coarse level: its band from the fine level at K */
+    lub_timer_start(&o->m[0].tm, LUB_T_OTHER);
+    o->st.nlower = o->st.nempty = 0;
+    for (int k = 0; k < o->nlevels; k++) o->st.nfixed[k] = mark_fixed(o, k);
+    for (int k = 0; k < o->nlevels; k++) lub_neighbours_bin(&o->src[k], o->P[k].n, o->P[k].x);
+    for (int k = 0; k < o->nlevels; k++) now[k] = source_now(o, k);
+    couple_level(o, C, now, NULL, -1, 0.0);
+    save_coarse(o);
+    const source old = {&o->PK, o->fixK, &o->srcK, &o->lsq[C], o->m[C].re, o->m[C].n0, o->fill[C]};
+    lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
+    if ((s = step_level(o, C, dt, level, bad, msg, msgsize)) != LUB_STEP_OK) return s;
+    lub_neighbours_bin(&o->src[C], o->P[C].n, o->P[C].x); /* state K + 1 */
+    o->st.nfull = 0;
+    o->st.ndeleted[F] = o->st.ngenerated[F] = 0;
+    for (int b = 0; b < nr; b++) {
+        lub_timer_start(&o->m[0].tm, LUB_T_OTHER);
+        o->st.nfixed[F] = mark_fixed(o, F);
+        couple_level(o, F, now, &old, C, lub_levels_time_weight(b, nr));
+        lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
+        if ((s = step_level(o, F, dtf, level, bad, msg, msgsize)) != LUB_STEP_OK) return s;
+        lub_timer_start(&o->m[0].tm, LUB_T_OTHER);
+        const size_t nd = delete_outside(o, F), ng = o->st.ngenerated[F];
+        lub_neighbours_bin(&o->src[F], o->P[F].n, o->P[F].x);
+        /* at the end of sub-step b: time K + (b + 1) / Nr */
+        generate(o, F, dtf, now, &old, C, lub_levels_time_weight(b + 1, nr));
+        if (nd || o->st.ngenerated[F] != ng) lub_mps_rebuild_lists(&o->m[F]);
+        o->st.ndeleted[F] += nd;
+        lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
+    }
+    /* the coarse level's transfer, from the fine level at K + 1 */
+    lub_timer_start(&o->m[0].tm, LUB_T_OTHER);
+    o->total_deleted[F] += o->st.ndeleted[F];
+    o->total_generated[F] += o->st.ngenerated[F];
+    o->st.ndeleted[C] = delete_outside(o, C);
+    o->st.ngenerated[C] = 0;
+    lub_neighbours_bin(&o->src[C], o->P[C].n, o->P[C].x);
+    lub_neighbours_bin(&o->src[F], o->P[F].n, o->P[F].x);
+    generate(o, C, dt, now, NULL, -1, 0.0);
+    transfer_done(o, C);
+    o->total_full += o->st.nfull;
+    lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
+    return LUB_STEP_OK;
+}
+
+lub_step_status lub_opt_step(lub_opt *o, double dt, int *level, long *bad, char *msg,
+                             size_t msgsize)
+{
+    *level = -1;
+    *bad = -1;
+    msg[0] = '\0';
+    o->st.piter = o->st.viter = 0;
+    if (o->nr > 1) return substeps(o, dt, level, bad, msg, msgsize);
+    lub_timer_start(&o->m[0].tm, LUB_T_OTHER); /* the coupling is charged to level 0 */
+    lub_opt_couple(o);
+    lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
+    for (int k = 0; k < o->nlevels; k++) {
+        lub_step_status s = step_level(o, k, dt, level, bad, msg, msgsize);
+        if (s != LUB_STEP_OK) return s;
+    }
+    lub_timer_start(&o->m[0].tm, LUB_T_OTHER);
+    lub_opt_transfer(o, dt);
+    lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
+    return LUB_STEP_OK;
+}
+
+/* ---- reports ----------------------------------------------------------------------------- */
+
+void lub_opt_mass_count(const lub_opt *o, lub_opt_mass *out)
+{
+    memset(out, 0, sizeof *out);
+    for (int k = 0; k < o->nlevels; k++) {
+        const lub_particles *P = &o->P[k];
+        size_t nf = 0, no = 0;
+#pragma omp parallel for schedule(static) reduction(+ : nf, no)
+        for (size_t i = 0; i < P->n; i++) {
+            if (P->kind[i] != LUB_FLUID) continue;
+            nf++;
+            lub_level_where w;
+            lub_levels_locate(&o->L, P->x[0][i], &w);
+            no += w.owner == k;
+        }
+        out->fluid[k] = nf;
+        out->owned[k] = no;
+        out->mass += o->m[k].c.rho * pow(o->m[k].l0, o->dim) * (double)no;
+    }
+}
+
+void lub_opt_rebuild_lists(lub_opt *o)
+{
+    for (int k = 0; k < o->nlevels; k++) lub_mps_rebuild_lists(&o->m[k]);
+}
+
+double lub_opt_courant_per_dt(const lub_opt *o, int *level)
+{
+    double best = 0;
+    int at = 0;
+    for (int k = 0; k < o->nlevels; k++) {
+        const double c = o->m[k].st.umax * (double)o->L.level[k].dt_factor / o->m[k].l0;
+        if (c > best) best = c, at = k;
+    }
+    if (level) *level = at;
+    return best;
+}

@@ -1,0 +1,190 @@
+/* lubkit MPS: the overlapping particle technique (OPT, multi-resolution; methods.md §3,
+ * thesis §2-2, Shibata's OPT).
+ *
+ * Each resolution level is its own MPS system (mps.h: one lub_mps per level, with its own
+ * l0, re = effectiveRadius l0, n0, lambda0, neighbour lists, viscosity and pressure solves);
+ * the levels never interact pairwise.  They are coupled in the overlaps (mps/levels.h for the
+ * regions): in the fixed band at the far edge of each level's overlap (T-25, T-26) the level's
+ * particles are not computed, their velocity and pressure are given, interpolated by weighted
+ * least squares (mps/lsq.h) from the other level's particles, and each level's free particles
+ * see them as boundary values:
+ *
+ *     viscosity (T-31):  the band's velocities are Dirichlet values of the implicit solve
+ *                        (§2-2-2 (3): velocities fixed outside L_outer);
+ *     pressure (T-9):    the band's pressures are Dirichlet values, like those of the free
+ *                        surface but not zero;
+ *     correction (T-16, T-17): a band particle keeps its given velocity and moves with it.
+ *
+ * The band is 4 l0 wide, wider than re = 3.1 l0, so that a free particle's neighbourhood is
+ * complete: the level's particles end at the outer edge of the band, and the truncated
+ * neighbourhoods there (PND deficit, one-sided) fall on Dirichlet particles only.  The
+ * sources of an interpolation are the other level's fluid and wall particles that are not in
+ * a band themselves (the two bands of an overlap never meet: mps/levels.c checks it), so
+ * every level is interpolated from the same state, that of the start of the step.  Dummy
+ * particles are not sources: they carry the wall velocity behind the wall, not the no-slip
+ * profile continued through it (step.c, dummy_velocity).  Particles move between the levels
+ * by deletion past a level's extended region and generation in one-cell layers at its edges
+ * (lub_opt_transfer, after every step).
+ *
+ * The fit is second order (LSQ, lsq.h) so that the parabola of a Poiseuille film is carried
+ * exactly; where the neighbours cannot fix it (near a wall on a coarse level) it falls back to
+ * first order or to the weighted mean, and the fallbacks are counted (lub_opt_stats).
+ *
+ * Walls.  A level's walls must stay in the part of x the level covers, so in a multi-
+ * resolution run the wall and dummy particles keep their positions (mps.h still_walls) and
+ * only carry their patch velocity: every wall must be at rest or a plane sliding along itself
+ * (movingWalls), which is translation invariant.  Other moving walls (and elasticWall) are
+ * refused at set-up.
+ *
+ * Particles.  particleGen generates each level only in the part of x it owns; at set-up each
+ * level's overlap margins are filled from the geometry (lub_geometry_discretise_range) when
+ * they hold none of the level's particles (a start from particleGen's file; a restart finds
+ * them filled).  The levels are split into one lub_particles each, with every field, id and
+ * extra field, and merged back (lub_opt_merge) for the time folders, level 0 first, each
+ * level in its memory order: a restart splits the file into the same arrays, so it repeats
+ * the uninterrupted run exactly.
+ *
+ * Time steps.  Every level takes the same dt (commonDeltaT, T-60), or, with two levels, the
+ * coarse level takes dt_coarse = Nr dt_fine (T-19) while the fine level takes Nr sub-steps
+ * (lub_opt_step).  The mass correction (T-27..T-29) is refused by the configuration reader.
+ *
+ * Ids.  Generated particles take ids from next_id on (set-up: one past the largest id of the
+ * particles; lubFoam keeps it in uniform/state.yaml, so that a restart continues it).
+ *
+ * Mass (T-27): M = rho sum over the fluid particles whose x the particle's level owns of
+ * l0_level^d (per unit depth in 2-D): each point of space counted on one level.
+ */
+#ifndef LUB_MPS_OPT_H
+#define LUB_MPS_OPT_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "geometry/geometry.h"
+#include "mps/levels.h"
+#include "mps/lsq.h"
+#include "mps/mps.h"
+
+/* The fluid mass per level (T-27). */
+typedef struct {
+    size_t fluid[LUB_MAX_LEVELS]; /* fluid particles of each level */
+    size_t owned[LUB_MAX_LEVELS]; /* of them, those in the part of x their level owns */
+    double mass;                  /* rho sum_k owned_k l0_k^d [kg, or kg/m in 2-D] */
+} lub_opt_mass;
+
+/* What the coupling did in the last step. */
+typedef struct {
+    size_t nfixed[LUB_MAX_LEVELS];     /* particles given by interpolation (fluid and wall) */
+    size_t nlower;                     /* fits below second order (fallback to order 1 or 0) */
+    size_t nempty;                     /* given particles without any source within re: they
+                                          kept their previous values */
+    size_t ndeleted[LUB_MAX_LEVELS];   /* fluid particles deleted past the extended region */
+    size_t ngenerated[LUB_MAX_LEVELS]; /* fluid particles generated in the generation layers */
+    size_t nfull;                      /* generations skipped: the level's capacity is full */
+    long piter, viter; /* pressure and viscosity iterations of all the level steps taken */
+} lub_opt_stats;
+
+typedef struct {
+    lub_levels L;
+    int nlevels, dim;
+    lub_particles P[LUB_MAX_LEVELS];     /* the particles of each level (nlevels = 1 each) */
+    lub_mps m[LUB_MAX_LEVELS];           /* and its solver */
+    lub_neighbours src[LUB_MAX_LEVELS];  /* cell list of each level's particles (cell >= re of
+                                            the level): the sources of the interpolation */
+    lub_lsq_options lsq[LUB_MAX_LEVELS]; /* fit from level k's particles */
+    int nthreads;
+    size_t cap_cand; /* candidate buffer per thread */
+    size_t *cand;
+    uint64_t next_id;              /* id of the next particle created */
+    size_t filled[LUB_MAX_LEVELS]; /* particles added to each level's margins at set-up */
+    lub_opt_stats st;
+    size_t total_generated[LUB_MAX_LEVELS], total_deleted[LUB_MAX_LEVELS], total_full;
+
+    /* particle transfer: the generation cells of each level, one lattice point each (the
+     * cell's centre) in the level's generation layers where the geometry allows fluid */
+    size_t ngen[LUB_MAX_LEVELS];
+    double *gen[LUB_MAX_LEVELS];     /* positions, 3 per cell */
+    uint8_t *gen_ok[LUB_MAX_LEVELS]; /* decision of the last pass */
+    double fill[LUB_MAX_LEVELS];     /* fill fraction of the level's fluid at its surface */
+
+    /* sub-stepping (T-19..T-22): the fine level takes nr steps per coarse step; the coarse
+     * level's state K (positions, velocities, pressures, kinds, given flags) is kept for the
+     * fine level's values between K and K + 1 */
+    int nr;
+    lub_particles PK;
+    uint8_t *fixK;
+    lub_neighbours srcK;
+    double *gen_val[LUB_MAX_LEVELS]; /* u (3), p, grad p (3) per cell */
+} lub_opt;
+
+/* Set up from the particles P of all levels (not modified; its arrays are copied), the levels
+ * L (mps/levels.h, checked against P), the solver configuration c (the same for every level;
+ * lub_mps_init per level) and the geometry g (domain, walls; used for the margins, the
+ * generation cells and the walls' check, not kept).  headroom: extra capacity per level, as a
+ * fraction of its count (for particles generated later).  Fatal (exit 1) for a moving wall
+ * that is not a plane sliding along itself, a patch moved by a model, or an extended region
+ * across the periodic seam. */
+void lub_opt_init(lub_opt *o, const lub_levels *L, const lub_particles *P, const lub_mps_config *c,
+                  const lub_geometry *g, double headroom);
+void lub_opt_free(lub_opt *o);
+
+/* One step of length dt on every level: flags the fixed bands, interpolates their velocity
+ * and pressure from the other level, then lub_mps_step on each level, then the particle
+ * transfer (lub_opt_transfer).  With sub-stepping (nr > 1) dt is the coarse level's step: the
+ * coarse level takes it (its band from the fine level at the start, state K), then the fine
+ * level takes nr steps of dt / nr, its bands and generation fed by the coarse values
+ * interpolated in time between K and K + 1 with the weights of lub_levels_time_weight
+ * (T-20..T-22 corrected: (Nr - b)/Nr for K at sub-step b); the coarse level's transfer
+ * follows, from the fine level at K + 1.  On failure *level is the level, *bad the particle
+ * index in it and msg names the level; as lub_mps_step. */
+lub_step_status lub_opt_step(lub_opt *o, double dt, int *level, long *bad, char *msg,
+                             size_t msgsize);
+
+/* The interpolation of the fixed bands alone (the first half of lub_opt_step): after it each
+ * level's fixed particles carry their given values. */
+void lub_opt_couple(lub_opt *o);
+
+/* The particle transfer after a step of length dt (the last part of lub_opt_step):
+ *   deletion:   a level's fluid particles outside its extended region (past the far edge of
+ *               an overlap, or into its hole) are deleted;
+ *   generation: in each generation cell (one l0 wide at the far edge of an overlap, thesis
+ *               §2-2-1, Fig. 2) a fluid particle is created at the cell's centre when the
+ *               other level's fluid fills the cell and this level's particles have left it.
+ * "Fills": the fraction of the part of B's neighbourhood of the cell centre c that is not
+ * wall which B's fluid occupies, n_B,fluid(c) / (n0_B - n_B,wall+dummy(c)) (PND sums of T-4),
+ * exceeds its value half a spacing above a plane free surface of B's lattice (lub_opt.fill,
+ * 0.601 in 2-D at re = 3.1 l0): a cell centre inside the fluid B's particles represent is
+ * filled, one above it, at the surface itself, or beside a dry wall is not; beside a wetted
+ * wall the fraction exceeds 1.  "Left": the level's nearest particle is at least
+ * l0 - |u| dt / 2 from c, u the velocity at c: in a uniform inflow a particle is then created
+ * every l0 / |u| on average, at the spacing l0 (the plain test "the cell holds no particle"
+ * creates the next particle when the last is half a cell away, at half the spacing).  The
+ * new particle's velocity, pressure and pressure gradient (the predictor's running mean
+ * gradP*) are interpolated from B by least squares (lsq.h); it starts in the fixed band.
+ * Cells inside walls are never candidates: they are the lattice points of the layer where
+ * particleGen's rules (lub_geometry_discretise_range over a full-domain box) allow fluid.
+ * Particle ids continue from next_id.  Without room in the level's arrays (the capacity is
+ * allocated at set-up) a generation is skipped and counted (stats.nfull). */
+void lub_opt_transfer(lub_opt *o, double dt);
+
+/* The particles of all levels into P (initialised by the caller with the same dimension;
+ * grown if needed, so reserve lub_opt_capacity() before a time loop): level 0 first, each in
+ * memory order, with the levels' reference values (l0, re, n0, lambda0), patches and extra
+ * fields.  P's time and step are left to the caller. */
+void lub_opt_merge(const lub_opt *o, lub_particles *P);
+/* Sum of the levels' capacities. */
+size_t lub_opt_capacity(const lub_opt *o);
+
+/* Fluid counts and mass (T-27), rho from the solver configuration. */
+void lub_opt_mass_count(const lub_opt *o, lub_opt_mass *out);
+
+/* Build every level's neighbour lists afresh at its next step (after writing a time folder:
+ * exact restart, as lub_mps_rebuild_lists). */
+void lub_opt_rebuild_lists(lub_opt *o);
+
+/* Largest ratio u_max dt_k / l0 over the levels after the last step, dt_k = dt_factor dt
+ * (the Courant number of T-18 of each level, for the finest dt = 1), and the level where it
+ * is. */
+double lub_opt_courant_per_dt(const lub_opt *o, int *level);
+
+#endif
