@@ -302,6 +302,15 @@ void lub_opt_init(lub_opt *o, const lub_levels *L, const lub_particles *P, const
     o->next_id = next;
     o->nthreads = omp_get_max_threads();
     o->cand = lub_malloc((size_t)o->nthreads * o->cap_cand * sizeof *o->cand);
+    o->rho = c->rho;
+    lub_opt_mass m0;
+    lub_opt_mass_count(o, &m0);
+    o->mass0 = m0.mass;
+}
+
+void lub_opt_set_mass0(lub_opt *o, double mass0)
+{
+    o->mass0 = mass0;
 }
 
 void lub_opt_free(lub_opt *o)
@@ -796,6 +805,76 @@ void lub_opt_transfer(lub_opt *o, double dt)
     o->total_full += o->st.nfull;
 }
 
+/* ---- mass correction (T-27..T-29, T-61; opt.h) ------------------------------------------- */
+
+/* The fine level's fluid cross-section of each overlap (A of T-28 is their sum): its fluid
+ * particles in the overlap times l0^d over the overlap's length. */
+static double overlap_area(const lub_opt *o)
+{
+    const lub_levels *L = &o->L;
+    double area = 0;
+    for (int b = 0; b < L->nboundaries; b++) {
+        const lub_level_boundary *bd = &L->boundary[b];
+        const lub_particles *P = &o->P[bd->fine];
+        size_t n = 0;
+#pragma omp parallel for schedule(static) reduction(+ : n)
+        for (size_t i = 0; i < P->n; i++) {
+            if (P->kind[i] != LUB_FLUID) continue;
+            lub_level_where w;
+            lub_levels_locate(L, P->x[0][i], &w);
+            n += w.boundary == b;
+        }
+        area += (double)n * pow(o->m[bd->fine].l0, o->dim) / (bd->hi - bd->lo);
+    }
+    return area;
+}
+
+/* After a step of length dt (the coarser level's): count M, and move the coarser level's
+ * fluid particles in the overlaps by the correction's displacement du dt when |M - M^0|
+ * exceeds the threshold. */
+static void mass_correct(lub_opt *o, double dt)
+{
+    const lub_levels *L = &o->L;
+    lub_opt_mass mc;
+    lub_opt_mass_count(o, &mc);
+    o->st.mass = mc.mass;
+    o->st.correction = 0;
+    o->st.area = 0;
+    o->st.ncorrected = 0;
+    const double err = mc.mass - o->mass0;
+    if (!L->mass_correction || !(o->mass0 > 0) || !(fabs(err) > L->threshold * o->mass0)) return;
+    const double area = overlap_area(o);
+    o->st.area = area;
+    if (!(area > 0)) return;
+    const double B = fmax(fmin(fabs(err) / (o->rho * area * L->relax * dt), L->c_max), L->c_min);
+    const double sg = err > 0 ? 1.0 : -1.0;
+    o->st.correction = B * sg;
+    size_t ncor = 0;
+    for (int b = 0; b < L->nboundaries; b++) {
+        const lub_level_boundary *bd = &L->boundary[b];
+        const int C = bd->coarse;
+        lub_particles *P = &o->P[C];
+        const double s = bd->side == 1 ? 1.0 : -1.0, du = -s * B * sg;
+        size_t n = 0;
+#pragma omp parallel for schedule(static) reduction(+ : n)
+        for (size_t i = 0; i < P->n; i++) {
+            if (P->kind[i] != LUB_FLUID) continue;
+            lub_level_where w;
+            lub_levels_locate(L, P->x[0][i], &w);
+            if (w.boundary != b) continue;
+            double x = P->x[0][i] + du * dt;
+            if (L->periodic) {
+                if (x < L->xmin) x += L->xmax - L->xmin;
+                if (x >= L->xmax) x -= L->xmax - L->xmin;
+            }
+            P->x[0][i] = x;
+            n++;
+        }
+        ncor += n;
+    }
+    o->st.ncorrected = ncor;
+}
+
 /* ---- the step ---------------------------------------------------------------------------- */
 
 static lub_step_status step_level(lub_opt *o, int k, double dt, int *level, long *bad, char *msg,
@@ -880,6 +959,7 @@ static lub_step_status substeps(lub_opt *o, double dt, int *level, long *bad, ch
     generate(o, C, dt, now, NULL, -1, 0.0);
     transfer_done(o, C);
     o->total_full += o->st.nfull;
+    mass_correct(o, dt);
     lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
     return LUB_STEP_OK;
 }
@@ -901,6 +981,7 @@ lub_step_status lub_opt_step(lub_opt *o, double dt, int *level, long *bad, char 
     }
     lub_timer_start(&o->m[0].tm, LUB_T_OTHER);
     lub_opt_transfer(o, dt);
+    mass_correct(o, dt);
     lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
     return LUB_STEP_OK;
 }
