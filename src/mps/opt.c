@@ -286,6 +286,7 @@ void lub_opt_init(lub_opt *o, const lub_levels *L, const lub_particles *P, const
         for (int d = 0; d < o->dim; d++)
             s->period[d] = g->periodic[d] ? g->dmax[d] - g->dmin[d] : 0.0;
         if (Q->cap > o->cap_cand) o->cap_cand = Q->cap;
+        o->drop[k] = lub_calloc(Q->cap, 1);
     }
     /* each level's step count (the reorder schedule of lub_mps_step) in its own steps: the
      * particle file counts the finest level's */
@@ -324,6 +325,7 @@ void lub_opt_free(lub_opt *o)
         free(o->gen[k]);
         free(o->gen_ok[k]);
         free(o->gen_val[k]);
+        free(o->drop[k]);
     }
     if (o->nr > 1) {
         lub_particles_free(&o->PK);
@@ -624,20 +626,15 @@ void lub_opt_couple(lub_opt *o)
 
 /* ---- particle transfer ------------------------------------------------------------------- */
 
-/* Delete level k's fluid particles outside its extended region (stable: the others keep
- * their order); returns the count. */
-static size_t delete_outside(lub_opt *o, int k)
+/* Delete the particles of level k with drop[i] set (stable: the others keep their order);
+ * returns the count. */
+static size_t compact(lub_opt *o, int k, const uint8_t *drop)
 {
     lub_particles *P = &o->P[k];
     uint8_t *fix = o->m[k].fixed;
-    const unsigned bit = 1u << k;
     size_t w = 0;
     for (size_t i = 0; i < P->n; i++) {
-        if (P->kind[i] == LUB_FLUID) {
-            lub_level_where lw;
-            lub_levels_locate(&o->L, P->x[0][i], &lw);
-            if (!(lw.present & bit)) continue;
-        }
+        if (drop[i]) continue;
         if (w != i) {
             for (int d = 0; d < 3; d++) {
                 P->x[d][w] = P->x[d][i];
@@ -656,6 +653,40 @@ static size_t delete_outside(lub_opt *o, int k)
     const size_t deleted = P->n - w;
     P->n = w;
     return deleted;
+}
+
+/* Delete level k's fluid particles outside its extended region; returns the count. */
+static size_t delete_outside(lub_opt *o, int k)
+{
+    const lub_particles *P = &o->P[k];
+    uint8_t *drop = o->drop[k];
+    const unsigned bit = 1u << k;
+    size_t n = 0;
+#pragma omp parallel for schedule(static) reduction(+ : n)
+    for (size_t i = 0; i < P->n; i++) {
+        drop[i] = 0;
+        if (P->kind[i] != LUB_FLUID) continue;
+        lub_level_where lw;
+        lub_levels_locate(&o->L, P->x[0][i], &lw);
+        drop[i] = !(lw.present & bit);
+        n += drop[i];
+    }
+    return n ? compact(o, k, drop) : 0;
+}
+
+/* Delete level k's given (fixed-band) fluid particles that the step of length dt took behind
+ * a wall layer (lub_mps_buried: their interpolated velocity carried them into a curved
+ * wall); returns the count.  They lie outside the part of x the level owns, so the mass of
+ * T-27 does not change. */
+static size_t delete_buried(lub_opt *o, int k, double dt)
+{
+    const size_t n = lub_mps_buried(&o->m[k], dt, o->drop[k]);
+    if (!n) return 0;
+    compact(o, k, o->drop[k]);
+    o->st.nburied[k] += n;
+    o->total_buried[k] += n;
+    lub_mps_rebuild_lists(&o->m[k]);
+    return n;
 }
 
 /* Whether a particle of level A is to be created at generation cell c (see lub_opt_transfer);
@@ -887,7 +918,9 @@ static lub_step_status step_level(lub_opt *o, int k, double dt, int *level, long
     if (s != LUB_STEP_OK) {
         *level = k;
         snprintf(msg, msgsize, "level %d (l0 %g): %s", k, o->m[k].l0, m);
+        return s;
     }
+    delete_buried(o, k, dt);
     return s;
 }
 
@@ -971,6 +1004,7 @@ lub_step_status lub_opt_step(lub_opt *o, double dt, int *level, long *bad, char 
     *bad = -1;
     msg[0] = '\0';
     o->st.piter = o->st.viter = 0;
+    for (int k = 0; k < o->nlevels; k++) o->st.nburied[k] = 0;
     if (o->nr > 1) return substeps(o, dt, level, bad, msg, msgsize);
     lub_timer_start(&o->m[0].tm, LUB_T_OTHER); /* the coupling is charged to level 0 */
     lub_opt_couple(o);

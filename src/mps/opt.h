@@ -30,6 +30,13 @@
  * exactly; where the neighbours cannot fix it (near a wall on a coarse level) it falls back to
  * first order or to the weighted mean, and the fallbacks are counted (lub_opt_stats).
  *
+ * Given particles and curved walls.  A band particle moves with its interpolated velocity,
+ * without the pressure that keeps computed particles off the walls; where the wall is curved
+ * (the cylinder at a1) the other level's coarser velocity field can carry it into the wall.
+ * Such a particle is deleted after the step (lub_mps_buried; counted in stats.nburied), not
+ * reported as a wall crossing: it is outside the part of x its level owns, so the mass is
+ * unchanged, and the generation layer or the band's inflow replaces it.
+ *
  * Walls.  A level's walls must stay in the part of x the level covers, so in a multi-
  * resolution run the wall and dummy particles keep their positions (mps.h still_walls) and
  * only carry their patch velocity: every wall must be at rest or a plane sliding along itself
@@ -114,6 +121,7 @@ typedef struct {
     size_t ndeleted[LUB_MAX_LEVELS];   /* fluid particles deleted past the extended region */
     size_t ngenerated[LUB_MAX_LEVELS]; /* fluid particles generated in the generation layers */
     size_t nfull;                      /* generations skipped: the level's capacity is full */
+    size_t nburied[LUB_MAX_LEVELS];    /* given fluid particles deleted behind a wall */
     long piter, viter; /* pressure and viscosity iterations of all the level steps taken */
     double mass;       /* M (T-27) after the step [kg, or kg/m in 2-D] */
     double correction; /* the mass correction's B sgn(M - M^0) of the step [m/s], 0 if none */
@@ -136,6 +144,8 @@ typedef struct {
     size_t filled[LUB_MAX_LEVELS]; /* particles added to each level's margins at set-up */
     lub_opt_stats st;
     size_t total_generated[LUB_MAX_LEVELS], total_deleted[LUB_MAX_LEVELS], total_full;
+    size_t total_buried[LUB_MAX_LEVELS];
+    uint8_t *drop[LUB_MAX_LEVELS]; /* scratch: particles to delete (capacity of the level) */
 
     /* particle transfer: the generation cells of each level, one lattice point each (the
      * cell's centre) in the level's generation layers where the geometry allows fluid */

@@ -196,6 +196,10 @@ static void log_line(const lubfoam_run *r, long steps_done, double wall0, double
                 "%sL%d p %d U %d surf %zu given %zu fluid %zu (+%zu -%zu)", k ? " | " : "", k,
                 o->m[k].st.p.iterations, viscosity_iterations(&o->m[k]), o->m[k].st.nsurface,
                 o->st.nfixed[k], mc.fluid[k], o->total_generated[k], o->total_deleted[k]);
+        for (int k = 0; k < o->nlevels && len < sizeof lv; k++)
+            if (o->total_buried[k])
+                len += (size_t)snprintf(lv + len, sizeof lv - len, " | L%d given in a wall %zu", k,
+                                        o->total_buried[k]);
         char corr[64] = "";
         if (o->L.mass_correction)
             snprintf(corr, sizeof corr, " (correction %+.3g m/s)", o->st.correction);
