@@ -120,11 +120,6 @@ static void read_solution(lub_mps_config *c, const char *path)
  * line.  Called after lub_dict_finish, so that a misspelt key is reported first. */
 static void check_supported(const lub_levels *L, lub_node *mr, lub_node *root)
 {
-    if (L->mass_correction)
-        lub_node_error(lub_dict_find(mr, "massCorrection"),
-                       "multiResolution: 'massCorrection' (T-27..T-29) is not available in this "
-                       "version of lubFoam: remove it (the mass with each point on one level is "
-                       "reported by the totals function object)");
     if (L->nlevels > 2)
         lub_node_error(mr, "multiResolution: %d levels: this version of lubFoam runs 2 levels",
                        L->nlevels);

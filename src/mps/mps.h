@@ -197,6 +197,14 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
  * particles itself builds them first (lub_neighbours_build(&m->nb, P->n, P->x)). */
 lub_step_status lub_mps_check(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize);
 
+/* Given particles (lub_mps.fixed: a multi-resolution level's fixed band, whose velocity is
+ * interpolated from another level) are not computed and may drift into a curved wall with
+ * that velocity; lub_mps_check does not stop the run for them.  flag[i] = 1 (P->n entries)
+ * for each given fluid particle that is now more than the check's depth behind its wall
+ * layer (the criterion of lub_mps_check, whatever its position before the step); returns
+ * their count.  The caller removes them (mps/opt.c). */
+size_t lub_mps_buried(const lub_mps *m, double dt, uint8_t *flag);
+
 /* Build the neighbour lists afresh at the next step.  The solver calls it after writing a
  * time folder, so that a run restarted from that folder (whose lists are built afresh)
  * repeats the uninterrupted run exactly: lists kept with a skin hold the same pairs but sum

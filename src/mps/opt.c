@@ -286,6 +286,7 @@ void lub_opt_init(lub_opt *o, const lub_levels *L, const lub_particles *P, const
         for (int d = 0; d < o->dim; d++)
             s->period[d] = g->periodic[d] ? g->dmax[d] - g->dmin[d] : 0.0;
         if (Q->cap > o->cap_cand) o->cap_cand = Q->cap;
+        o->drop[k] = lub_calloc(Q->cap, 1);
     }
     /* each level's step count (the reorder schedule of lub_mps_step) in its own steps: the
      * particle file counts the finest level's */
@@ -302,6 +303,15 @@ void lub_opt_init(lub_opt *o, const lub_levels *L, const lub_particles *P, const
     o->next_id = next;
     o->nthreads = omp_get_max_threads();
     o->cand = lub_malloc((size_t)o->nthreads * o->cap_cand * sizeof *o->cand);
+    o->rho = c->rho;
+    lub_opt_mass m0;
+    lub_opt_mass_count(o, &m0);
+    o->mass0 = m0.mass;
+}
+
+void lub_opt_set_mass0(lub_opt *o, double mass0)
+{
+    o->mass0 = mass0;
 }
 
 void lub_opt_free(lub_opt *o)
@@ -315,6 +325,7 @@ void lub_opt_free(lub_opt *o)
         free(o->gen[k]);
         free(o->gen_ok[k]);
         free(o->gen_val[k]);
+        free(o->drop[k]);
     }
     if (o->nr > 1) {
         lub_particles_free(&o->PK);
@@ -615,20 +626,15 @@ void lub_opt_couple(lub_opt *o)
 
 /* ---- particle transfer ------------------------------------------------------------------- */
 
-/* Delete level k's fluid particles outside its extended region (stable: the others keep
- * their order); returns the count. */
-static size_t delete_outside(lub_opt *o, int k)
+/* Delete the particles of level k with drop[i] set (stable: the others keep their order);
+ * returns the count. */
+static size_t compact(lub_opt *o, int k, const uint8_t *drop)
 {
     lub_particles *P = &o->P[k];
     uint8_t *fix = o->m[k].fixed;
-    const unsigned bit = 1u << k;
     size_t w = 0;
     for (size_t i = 0; i < P->n; i++) {
-        if (P->kind[i] == LUB_FLUID) {
-            lub_level_where lw;
-            lub_levels_locate(&o->L, P->x[0][i], &lw);
-            if (!(lw.present & bit)) continue;
-        }
+        if (drop[i]) continue;
         if (w != i) {
             for (int d = 0; d < 3; d++) {
                 P->x[d][w] = P->x[d][i];
@@ -647,6 +653,40 @@ static size_t delete_outside(lub_opt *o, int k)
     const size_t deleted = P->n - w;
     P->n = w;
     return deleted;
+}
+
+/* Delete level k's fluid particles outside its extended region; returns the count. */
+static size_t delete_outside(lub_opt *o, int k)
+{
+    const lub_particles *P = &o->P[k];
+    uint8_t *drop = o->drop[k];
+    const unsigned bit = 1u << k;
+    size_t n = 0;
+#pragma omp parallel for schedule(static) reduction(+ : n)
+    for (size_t i = 0; i < P->n; i++) {
+        drop[i] = 0;
+        if (P->kind[i] != LUB_FLUID) continue;
+        lub_level_where lw;
+        lub_levels_locate(&o->L, P->x[0][i], &lw);
+        drop[i] = !(lw.present & bit);
+        n += drop[i];
+    }
+    return n ? compact(o, k, drop) : 0;
+}
+
+/* Delete level k's given (fixed-band) fluid particles that the step of length dt took behind
+ * a wall layer (lub_mps_buried: their interpolated velocity carried them into a curved
+ * wall); returns the count.  They lie outside the part of x the level owns, so the mass of
+ * T-27 does not change. */
+static size_t delete_buried(lub_opt *o, int k, double dt)
+{
+    const size_t n = lub_mps_buried(&o->m[k], dt, o->drop[k]);
+    if (!n) return 0;
+    compact(o, k, o->drop[k]);
+    o->st.nburied[k] += n;
+    o->total_buried[k] += n;
+    lub_mps_rebuild_lists(&o->m[k]);
+    return n;
 }
 
 /* Whether a particle of level A is to be created at generation cell c (see lub_opt_transfer);
@@ -796,6 +836,76 @@ void lub_opt_transfer(lub_opt *o, double dt)
     o->total_full += o->st.nfull;
 }
 
+/* ---- mass correction (T-27..T-29, T-61; opt.h) ------------------------------------------- */
+
+/* The fine level's fluid cross-section of each overlap (A of T-28 is their sum): its fluid
+ * particles in the overlap times l0^d over the overlap's length. */
+static double overlap_area(const lub_opt *o)
+{
+    const lub_levels *L = &o->L;
+    double area = 0;
+    for (int b = 0; b < L->nboundaries; b++) {
+        const lub_level_boundary *bd = &L->boundary[b];
+        const lub_particles *P = &o->P[bd->fine];
+        size_t n = 0;
+#pragma omp parallel for schedule(static) reduction(+ : n)
+        for (size_t i = 0; i < P->n; i++) {
+            if (P->kind[i] != LUB_FLUID) continue;
+            lub_level_where w;
+            lub_levels_locate(L, P->x[0][i], &w);
+            n += w.boundary == b;
+        }
+        area += (double)n * pow(o->m[bd->fine].l0, o->dim) / (bd->hi - bd->lo);
+    }
+    return area;
+}
+
+/* After a step of length dt (the coarser level's): count M, and move the coarser level's
+ * fluid particles in the overlaps by the correction's displacement du dt when |M - M^0|
+ * exceeds the threshold. */
+static void mass_correct(lub_opt *o, double dt)
+{
+    const lub_levels *L = &o->L;
+    lub_opt_mass mc;
+    lub_opt_mass_count(o, &mc);
+    o->st.mass = mc.mass;
+    o->st.correction = 0;
+    o->st.area = 0;
+    o->st.ncorrected = 0;
+    const double err = mc.mass - o->mass0;
+    if (!L->mass_correction || !(o->mass0 > 0) || !(fabs(err) > L->threshold * o->mass0)) return;
+    const double area = overlap_area(o);
+    o->st.area = area;
+    if (!(area > 0)) return;
+    const double B = fmax(fmin(fabs(err) / (o->rho * area * L->relax * dt), L->c_max), L->c_min);
+    const double sg = err > 0 ? 1.0 : -1.0;
+    o->st.correction = B * sg;
+    size_t ncor = 0;
+    for (int b = 0; b < L->nboundaries; b++) {
+        const lub_level_boundary *bd = &L->boundary[b];
+        const int C = bd->coarse;
+        lub_particles *P = &o->P[C];
+        const double s = bd->side == 1 ? 1.0 : -1.0, du = -s * B * sg;
+        size_t n = 0;
+#pragma omp parallel for schedule(static) reduction(+ : n)
+        for (size_t i = 0; i < P->n; i++) {
+            if (P->kind[i] != LUB_FLUID) continue;
+            lub_level_where w;
+            lub_levels_locate(L, P->x[0][i], &w);
+            if (w.boundary != b) continue;
+            double x = P->x[0][i] + du * dt;
+            if (L->periodic) {
+                if (x < L->xmin) x += L->xmax - L->xmin;
+                if (x >= L->xmax) x -= L->xmax - L->xmin;
+            }
+            P->x[0][i] = x;
+            n++;
+        }
+        ncor += n;
+    }
+    o->st.ncorrected = ncor;
+}
+
 /* ---- the step ---------------------------------------------------------------------------- */
 
 static lub_step_status step_level(lub_opt *o, int k, double dt, int *level, long *bad, char *msg,
@@ -808,7 +918,9 @@ static lub_step_status step_level(lub_opt *o, int k, double dt, int *level, long
     if (s != LUB_STEP_OK) {
         *level = k;
         snprintf(msg, msgsize, "level %d (l0 %g): %s", k, o->m[k].l0, m);
+        return s;
     }
+    delete_buried(o, k, dt);
     return s;
 }
 
@@ -880,6 +992,7 @@ static lub_step_status substeps(lub_opt *o, double dt, int *level, long *bad, ch
     generate(o, C, dt, now, NULL, -1, 0.0);
     transfer_done(o, C);
     o->total_full += o->st.nfull;
+    mass_correct(o, dt);
     lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
     return LUB_STEP_OK;
 }
@@ -891,6 +1004,7 @@ lub_step_status lub_opt_step(lub_opt *o, double dt, int *level, long *bad, char 
     *bad = -1;
     msg[0] = '\0';
     o->st.piter = o->st.viter = 0;
+    for (int k = 0; k < o->nlevels; k++) o->st.nburied[k] = 0;
     if (o->nr > 1) return substeps(o, dt, level, bad, msg, msgsize);
     lub_timer_start(&o->m[0].tm, LUB_T_OTHER); /* the coupling is charged to level 0 */
     lub_opt_couple(o);
@@ -901,6 +1015,7 @@ lub_step_status lub_opt_step(lub_opt *o, double dt, int *level, long *bad, char 
     }
     lub_timer_start(&o->m[0].tm, LUB_T_OTHER);
     lub_opt_transfer(o, dt);
+    mass_correct(o, dt);
     lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
     return LUB_STEP_OK;
 }

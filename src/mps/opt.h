@@ -30,6 +30,13 @@
  * exactly; where the neighbours cannot fix it (near a wall on a coarse level) it falls back to
  * first order or to the weighted mean, and the fallbacks are counted (lub_opt_stats).
  *
+ * Given particles and curved walls.  A band particle moves with its interpolated velocity,
+ * without the pressure that keeps computed particles off the walls; where the wall is curved
+ * (the cylinder at a1) the other level's coarser velocity field can carry it into the wall.
+ * Such a particle is deleted after the step (lub_mps_buried; counted in stats.nburied), not
+ * reported as a wall crossing: it is outside the part of x its level owns, so the mass is
+ * unchanged, and the generation layer or the band's inflow replaces it.
+ *
  * Walls.  A level's walls must stay in the part of x the level covers, so in a multi-
  * resolution run the wall and dummy particles keep their positions (mps.h still_walls) and
  * only carry their patch velocity: every wall must be at rest or a plane sliding along itself
@@ -46,7 +53,40 @@
  *
  * Time steps.  Every level takes the same dt (commonDeltaT, T-60), or, with two levels, the
  * coarse level takes dt_coarse = Nr dt_fine (T-19) while the fine level takes Nr sub-steps
- * (lub_opt_step).  The mass correction (T-27..T-29) is refused by the configuration reader.
+ * (lub_opt_step).
+ *
+ * Mass correction (T-27..T-29, T-61; massCorrection in multiResolution).  After each step
+ * (each coarse step when sub-stepping) the mass M of T-27 is counted; when
+ * |M - M^0| > threshold M^0 the coarser level's fluid particles in each overlap (outside its
+ * fixed band, which is given anyway) move with the x-velocity correction
+ *
+ *     du = -s B sgn(M - M^0),   B = max(min(|M - M^0| / (rho A C_relax dt), cMax), cMin),
+ *
+ * s = +1 at a boundary where the fine level owns the x below it (a2), -1 where it owns the x
+ * above it (a1); A is the summed cross-section of the overlaps' fluid (the fine level's fluid
+ * particles in each overlap times l0_fine^d over the overlap's length: the film thickness in
+ * 2-D, per unit depth) and dt the coarser level's step.  Why one level and this sign: the
+ * levels conserve their own particles except at the far edges of their extended regions
+ * (deletion, generation), which lie away from the boundary a where the ownership of T-27
+ * changes, so M changes only by the two levels' fluxes through a,
+ *
+ *     dM/dt = rho s (F_coarse(a) - F_fine(a))      (F: volume flux in +x through a),
+ *
+ * and a correction given to the particles of both levels alike moves both fluxes equally and
+ * leaves M unchanged.  Moving the coarser level's particles alone changes M by
+ * -rho B A sgn(M - M^0) dt per step: with B unlimited the error falls by the factor
+ * 1 - 1/C_relax per step (T-28's relaxation), and at most at the rate rho cMax A.  The thesis
+ * (T-27) gives "the particles in the overlap region" and the sign sgn(M^k - M^0) without the
+ * direction; the coarser level is also the one whose accuracy matters less (the fine level's
+ * solution near a boundary is left alone).  The correction is a correction of the particles'
+ * motion, not of their momentum: at the end of the step they are displaced by du dt, the
+ * distance du adds over the step, and their velocity is left as the step computed it.  Added
+ * to the stored velocity instead, it would be added again at every step while the error
+ * lasts (a body force B / dt, whose effect on M is set by the viscous drag, not by T-28)
+ * and be diffused through the film by the implicit viscosity step (nu dt / l0^2 is about 1
+ * on the thesis' coarse level); as a displacement, M moves back by rho B A dt per
+ * step.  M^0 is the mass at the start of the run (lubFoam keeps it in
+ * uniform/state.yaml); lub_opt_stats reports M, B and the particles corrected.
  *
  * Ids.  Generated particles take ids from next_id on (set-up: one past the largest id of the
  * particles; lubFoam keeps it in uniform/state.yaml, so that a restart continues it).
@@ -81,7 +121,12 @@ typedef struct {
     size_t ndeleted[LUB_MAX_LEVELS];   /* fluid particles deleted past the extended region */
     size_t ngenerated[LUB_MAX_LEVELS]; /* fluid particles generated in the generation layers */
     size_t nfull;                      /* generations skipped: the level's capacity is full */
+    size_t nburied[LUB_MAX_LEVELS];    /* given fluid particles deleted behind a wall */
     long piter, viter; /* pressure and viscosity iterations of all the level steps taken */
+    double mass;       /* M (T-27) after the step [kg, or kg/m in 2-D] */
+    double correction; /* the mass correction's B sgn(M - M^0) of the step [m/s], 0 if none */
+    double area;       /* A of T-28: the overlaps' fluid cross-section [m^(d-1)] */
+    size_t ncorrected; /* particles given the correction */
 } lub_opt_stats;
 
 typedef struct {
@@ -99,6 +144,8 @@ typedef struct {
     size_t filled[LUB_MAX_LEVELS]; /* particles added to each level's margins at set-up */
     lub_opt_stats st;
     size_t total_generated[LUB_MAX_LEVELS], total_deleted[LUB_MAX_LEVELS], total_full;
+    size_t total_buried[LUB_MAX_LEVELS];
+    uint8_t *drop[LUB_MAX_LEVELS]; /* scratch: particles to delete (capacity of the level) */
 
     /* particle transfer: the generation cells of each level, one lattice point each (the
      * cell's centre) in the level's generation layers where the geometry allows fluid */
@@ -115,6 +162,9 @@ typedef struct {
     uint8_t *fixK;
     lub_neighbours srcK;
     double *gen_val[LUB_MAX_LEVELS]; /* u (3), p, grad p (3) per cell */
+
+    double rho;   /* density (the mass of T-27) */
+    double mass0; /* M^0 of the mass correction (set-up: the mass of the particles given) */
 } lub_opt;
 
 /* Set up from the particles P of all levels (not modified; its arrays are copied), the levels
@@ -135,7 +185,8 @@ void lub_opt_free(lub_opt *o);
  * level takes nr steps of dt / nr, its bands and generation fed by the coarse values
  * interpolated in time between K and K + 1 with the weights of lub_levels_time_weight
  * (T-20..T-22 corrected: (Nr - b)/Nr for K at sub-step b); the coarse level's transfer
- * follows, from the fine level at K + 1.  On failure *level is the level, *bad the particle
+ * follows, from the fine level at K + 1.  Last, the mass count and correction (T-27..T-29,
+ * above) with the coarse dt.  On failure *level is the level, *bad the particle
  * index in it and msg names the level; as lub_mps_step. */
 lub_step_status lub_opt_step(lub_opt *o, double dt, int *level, long *bad, char *msg,
                              size_t msgsize);
@@ -174,6 +225,9 @@ void lub_opt_transfer(lub_opt *o, double dt);
 void lub_opt_merge(const lub_opt *o, lub_particles *P);
 /* Sum of the levels' capacities. */
 size_t lub_opt_capacity(const lub_opt *o);
+
+/* Set M^0 of the mass correction (a restart: the value of the run it continues). */
+void lub_opt_set_mass0(lub_opt *o, double mass0);
 
 /* Fluid counts and mass (T-27), rho from the solver configuration. */
 void lub_opt_mass_count(const lub_opt *o, lub_opt_mass *out);

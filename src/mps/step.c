@@ -733,6 +733,7 @@ static long through_wall(const lub_mps *m, double dt, unsigned *patch, double *t
         for (size_t q = nb->start[d]; q < nb->start[d + 1]; q++) {
             const size_t i = nb->j[q];
             if (P->kind[i] != LUB_FLUID || (long)i >= first) continue;
+            if (m->fixed && m->fixed[i]) continue; /* given: lub_mps_buried */
             if (!(lub_neighbours_r(nb, x, d, i, NULL) < g2)) continue;
             double a, b;
             if (through(m, dt, i, P->patch[d], &a, &b)) first = (long)i;
@@ -746,6 +747,30 @@ static long through_wall(const lub_mps *m, double dt, unsigned *patch, double *t
             break;
         }
     return first;
+}
+
+size_t lub_mps_buried(const lub_mps *m, double dt, uint8_t *flag)
+{
+    const lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    double *const x[3] = {P->x[0], P->x[1], P->x[2]};
+    const double g2 = THROUGH_GATE * THROUGH_GATE * m->l0 * m->l0;
+    memset(flag, 0, P->n);
+    if (!m->fixed) return 0;
+    size_t n = 0;
+    /* serial: a fluid particle may be a neighbour of several dummies */
+    for (size_t d = 0; d < P->n; d++) {
+        if (P->kind[d] != LUB_DUMMY) continue;
+        for (size_t q = nb->start[d]; q < nb->start[d + 1]; q++) {
+            const size_t i = nb->j[q];
+            if (P->kind[i] != LUB_FLUID || !m->fixed[i] || flag[i]) continue;
+            if (!(lub_neighbours_r(nb, x, d, i, NULL) < g2)) continue;
+            double a = 0, b = 0;
+            through(m, dt, i, P->patch[d], &a, &b);
+            if (b > THROUGH_DEPTH * m->l0) flag[i] = 1, n++;
+        }
+    }
+    return n;
 }
 
 lub_step_status lub_mps_check(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize)

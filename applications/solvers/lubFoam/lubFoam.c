@@ -196,10 +196,17 @@ static void log_line(const lubfoam_run *r, long steps_done, double wall0, double
                 "%sL%d p %d U %d surf %zu given %zu fluid %zu (+%zu -%zu)", k ? " | " : "", k,
                 o->m[k].st.p.iterations, viscosity_iterations(&o->m[k]), o->m[k].st.nsurface,
                 o->st.nfixed[k], mc.fluid[k], o->total_generated[k], o->total_deleted[k]);
-        lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g %s  mass %+.3f%%  "
+        for (int k = 0; k < o->nlevels && len < sizeof lv; k++)
+            if (o->total_buried[k])
+                len += (size_t)snprintf(lv + len, sizeof lv - len, " | L%d given in a wall %zu", k,
+                                        o->total_buried[k]);
+        char corr[64] = "";
+        if (o->L.mass_correction)
+            snprintf(corr, sizeof corr, " (correction %+.3g m/s)", o->st.correction);
+        lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g %s  mass %+.3f%%%s  "
                     "(p it per step, all levels: %.1f)  ETA %s",
                     r->t, 100 * frac, r->step, r->dt, lub_opt_courant_per_dt(o, NULL) * r->dt, lv,
-                    r->mass0 > 0 ? 100 * (mc.mass / r->mass0 - 1) : 0.0,
+                    r->mass0 > 0 ? 100 * (mc.mass / r->mass0 - 1) : 0.0, corr,
                     steps_done ? pit_sum / (double)steps_done : 0.0, eta);
         return;
     }
@@ -333,6 +340,7 @@ int main(int argc, char **argv)
             if (r.next_id > r.opt->next_id) r.opt->next_id = r.next_id;
             if (r.state_mass0 > 0) r.mass0 = r.state_mass0;
         }
+        lub_opt_set_mass0(r.opt, r.mass0);
     } else {
         lub_mps_init(&r.mps, &r.P, &cfg, geo.dmin, geo.dmax, geo.periodic);
         lubfoam_read_elastic(&r, &geo);
