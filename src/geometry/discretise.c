@@ -652,6 +652,16 @@ static int in_region(const lub_geometry *g, const lub_region *r, const double *x
     return 0;
 }
 
+int lub_geometry_fluid_at(const lub_geometry *g, const double *x, double tol)
+{
+    int inside = 0;
+    for (int r = 0; r < g->nregions && !inside; r++) inside = in_region(g, &g->regions[r], x, tol);
+    if (!inside) return 0;
+    for (int w = 0; w < g->nwalls; w++)
+        if (lub_wall_behind(&g->walls[w], x, g->dim, 0.0)) return 0;
+    return 1;
+}
+
 /* Bounding box of a region's lattice search (domain, narrowed where cheap to know). */
 static void region_bbox(const lub_geometry *g, const lub_region *r, double *lo, double *hi)
 {

@@ -56,4 +56,9 @@ void lub_geometry_discretise_range(const lub_geometry *g, int level, double xlo,
  * span (x-range for planes, segments and polylines). */
 int lub_wall_behind(const lub_wall *w, const double *x, int dim, double tol);
 
+/* 1 when point x is fluid by the geometry alone: inside a fluid region (within tol) and
+ * behind no wall.  Unlike the particles, no wallGap is kept from the walls: a film between
+ * two walls is fluid from one surface to the other. */
+int lub_geometry_fluid_at(const lub_geometry *g, const double *x, double tol);
+
 #endif

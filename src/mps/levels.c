@@ -6,8 +6,9 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "geometry/discretise.h"
 
-#define NR_MAX 1024L
+#define NR_MAX        1024L
 #define DT_FACTOR_MAX (1L << 30)
 
 /* "file:line" of a node, for messages that point at a second file. */
@@ -119,8 +120,7 @@ static void check_restated(lub_levels *L, lub_node *lv, lub_node *mr, const lub_
                     lub_node_error(rn,
                                    "multiResolution: level %zu's region [%g, %g] differs from "
                                    "[%g, %g] in %s, which generated the particles",
-                                   k, r[0], r[1], s->xmin, s->xmax,
-                                   where(s->node, wb, sizeof wb));
+                                   k, r[0], r[1], s->xmin, s->xmax, where(s->node, wb, sizeof wb));
                 if (k == 0) region0_given = 1;
             }
             if (lub_dict_has(m, "fixedBand")) *band_override = 1;
@@ -177,8 +177,8 @@ static void read_substeps(lub_levels *L, lub_node *mr, const lub_geometry *g)
                                "dt_%d (T-19) cannot default to it; give 'Nr' (an integer) or "
                                "'commonDeltaT: true', or make the l0 ratio an integer",
                                k + 1, L->level[k + 1].l0,
-                               where(g->levels[k + 1].node, wb, sizeof wb), q, k,
-                               L->level[k].l0, k + 1, k);
+                               where(g->levels[k + 1].node, wb, sizeof wb), q, k, L->level[k].l0,
+                               k + 1, k);
             L->level[k].nr = (int)r;
         }
     }
@@ -271,8 +271,8 @@ static void check_overlaps(const lub_levels *L, lub_node *mr, lub_node *ovn, lub
                        "between them (%g m long, %s); enlarge that region or shorten 'overlap' "
                        "(L = %g l0_coarse + %g l0_fine)",
                        a->x, a->lo, a->hi, b->x, b->lo, b->hi, w.owner, b->x - a->x,
-                       where(g->levels[w.owner].node, wb, sizeof wb),
-                       L->overlap_coarse, L->overlap_fine);
+                       where(g->levels[w.owner].node, wb, sizeof wb), L->overlap_coarse,
+                       L->overlap_fine);
     }
     if (L->nboundaries == 0) return;
     const lub_level_boundary *first = &L->boundary[0], *last = &L->boundary[L->nboundaries - 1];
@@ -288,7 +288,7 @@ static void check_overlaps(const lub_levels *L, lub_node *mr, lub_node *ovn, lub
                            last->coarse, first->x + period - last->x, L->overlap_coarse,
                            L->overlap_fine);
     } else {
-        const lub_level_boundary *b = !(first->lo > L->xmin) ? first
+        const lub_level_boundary *b = !(first->lo > L->xmin)  ? first
                                       : !(last->hi < L->xmax) ? last
                                                               : NULL;
         if (b)
@@ -421,9 +421,9 @@ void lub_levels_locate(const lub_levels *L, double x, lub_level_where *w)
 void lub_levels_describe(const lub_levels *L, char *buf, size_t size)
 {
     size_t len = 0;
-#define PUT(...)                                                                                 \
-    do {                                                                                         \
-        if (len < size) len += (size_t)snprintf(buf + len, size - len, __VA_ARGS__);            \
+#define PUT(...)                                                                                   \
+    do {                                                                                           \
+        if (len < size) len += (size_t)snprintf(buf + len, size - len, __VA_ARGS__);               \
     } while (0)
     PUT("%d levels: l0", L->nlevels);
     for (int k = 0; k < L->nlevels; k++) {
@@ -437,8 +437,7 @@ void lub_levels_describe(const lub_levels *L, char *buf, size_t size)
         for (int k = 0; k < L->nlevels - 1; k++) PUT("%s%d", k ? "," : " ", L->level[k].nr);
     }
     PUT("; overlap");
-    for (int k = 0; k < L->nlevels - 1; k++)
-        PUT("%s%g", k ? "," : " ", lub_levels_overlap(L, k));
+    for (int k = 0; k < L->nlevels - 1; k++) PUT("%s%g", k ? "," : " ", lub_levels_overlap(L, k));
     PUT(" m; bands");
     for (int k = 0; k < L->nlevels; k++) PUT("%s%g", k ? "," : " ", L->level[k].band);
     PUT(" m");
@@ -448,4 +447,98 @@ void lub_levels_describe(const lub_levels *L, char *buf, size_t size)
     else
         PUT("; no mass correction");
 #undef PUT
+}
+
+/* ---- the film across a boundary (start-up check) ---------------------------------------- */
+
+typedef struct {
+    const lub_geometry *g;
+    double x, z;
+} column;
+
+static void column_point(const column *c, double y, double *p)
+{
+    p[0] = c->x;
+    p[1] = y;
+    p[2] = c->z;
+}
+
+static int column_solid(const column *c, double y)
+{
+    double p[3];
+    column_point(c, y, p);
+    for (int w = 0; w < c->g->nwalls; w++)
+        if (lub_wall_behind(&c->g->walls[w], p, c->g->dim, 0.0)) return w + 1;
+    return 0;
+}
+
+static int column_fluid(const column *c, double y)
+{
+    double p[3];
+    column_point(c, y, p);
+    return lub_geometry_fluid_at(c->g, p, 0.0);
+}
+
+/* The edge of a property between y0 (where pred is a) and y1 (where it is !a), by bisection. */
+static double column_edge(const column *c, int (*pred)(const column *, double), double y0,
+                          double y1)
+{
+    const int a = pred(c, y0) != 0;
+    for (int it = 0; it < 80 && y0 != y1; it++) {
+        double m = 0.5 * (y0 + y1);
+        if (m == y0 || m == y1) break;
+        if ((pred(c, m) != 0) == a)
+            y0 = m;
+        else
+            y1 = m;
+    }
+    return 0.5 * (y0 + y1);
+}
+
+void lub_levels_gap(const lub_geometry *g, double x, double dy, lub_level_gap *gap)
+{
+    memset(gap, 0, sizeof *gap);
+    gap->kind = LUB_GAP_NONE;
+    gap->wall_lo = gap->wall_hi = -1;
+    column c = {g, x, 0.0};
+    if (g->dim == 3 && !(g->dmin[2] <= 0.0 && g->dmax[2] >= 0.0))
+        c.z = 0.5 * (g->dmin[2] + g->dmax[2]);
+    const double ymin = g->dmin[1], ymax = g->dmax[1], span = ymax - ymin;
+    if (!(span > 0.0)) return;
+    double nn = dy > 0.0 ? ceil(span / dy) + 1.0 : 1001.0;
+    long n = nn < 1001.0 ? 1001 : nn > 1e6 ? 1000000 : (long)nn;
+    const double h = span / (double)(n - 1);
+#define YAT(j) ((j) == n - 1 ? ymax : ymin + (double)(j)*h)
+    /* the open run (no wall behind) holding the most fluid samples */
+    long best0 = -1, best1 = -1, bestf = 0, j0 = -1, nf = 0, f0 = -1, f1 = -1, bf0 = -1, bf1 = -1;
+    for (long j = 0; j <= n; j++) {
+        const int open = j < n && !column_solid(&c, YAT(j));
+        if (open) {
+            if (j0 < 0) j0 = j, nf = 0, f0 = f1 = -1;
+            if (column_fluid(&c, YAT(j))) {
+                if (f0 < 0) f0 = j;
+                f1 = j;
+                nf++;
+            }
+            continue;
+        }
+        if (j0 >= 0 && nf > bestf) best0 = j0, best1 = j - 1, bestf = nf, bf0 = f0, bf1 = f1;
+        j0 = -1;
+    }
+    if (bestf == 0) return;
+    gap->ylo = best0 == 0 ? ymin : column_edge(&c, column_solid, YAT(best0 - 1), YAT(best0));
+    gap->yhi = best1 == n - 1 ? ymax : column_edge(&c, column_solid, YAT(best1 + 1), YAT(best1));
+    if (best0 > 0) gap->wall_lo = column_solid(&c, YAT(best0 - 1)) - 1;
+    if (best1 < n - 1) gap->wall_hi = column_solid(&c, YAT(best1 + 1)) - 1;
+    if (gap->wall_lo >= 0 && gap->wall_hi >= 0) {
+        gap->kind = LUB_GAP_WALLS;
+        gap->h = gap->yhi - gap->ylo;
+    } else {
+        /* a free surface: the fluid's extent in the open space */
+        double lo = bf0 == 0 ? ymin : column_edge(&c, column_fluid, YAT(bf0), YAT(bf0 - 1));
+        double hi = bf1 == n - 1 ? ymax : column_edge(&c, column_fluid, YAT(bf1), YAT(bf1 + 1));
+        gap->kind = LUB_GAP_FLUID;
+        gap->h = hi - lo;
+    }
+#undef YAT
 }

@@ -92,10 +92,10 @@ typedef struct {
 } lub_level_def;
 
 typedef struct {
-    double x;          /* boundary position: a1 (side 0) or a2 (side 1) of level `fine` */
-    int fine, coarse;  /* the two levels (coarse = fine + 1) */
-    int side;          /* 0: the fine level owns x > a (a1); 1: it owns x < a (a2) */
-    double lo, hi;     /* the overlap [lo, hi], hi - lo = L */
+    double x;         /* boundary position: a1 (side 0) or a2 (side 1) of level `fine` */
+    int fine, coarse; /* the two levels (coarse = fine + 1) */
+    int side;         /* 0: the fine level owns x > a (a1); 1: it owns x < a (a2) */
+    double lo, hi;    /* the overlap [lo, hi], hi - lo = L */
 } lub_level_boundary;
 
 typedef struct {
@@ -110,10 +110,10 @@ typedef struct {
     double overlap_coarse, overlap_fine; /* L = overlap_coarse l0_coarse + overlap_fine l0_fine */
     int common_dt;                       /* commonDeltaT: every level takes dt of level 0 */
 
-    int mass_correction;  /* massCorrection given */
-    double c_max, c_min;  /* [m/s] (c_min 0: no lower limit, T-61) */
-    double relax;         /* C_relax of T-28 */
-    double threshold;     /* M' / M^0 of T-27 */
+    int mass_correction; /* massCorrection given */
+    double c_max, c_min; /* [m/s] (c_min 0: no lower limit, T-61) */
+    double relax;        /* C_relax of T-28 */
+    double threshold;    /* M' / M^0 of T-27 */
 
     /* where multiResolution is, for later messages (start-up checks of the solver) */
     char file[512];
@@ -157,6 +157,32 @@ static inline double lub_levels_time_weight(int b, int nr)
 {
     return (double)(nr - b) / (double)nr;
 }
+
+/* The film across a boundary, for the solver's start-up check of the coarse resolution
+ * (methods.md §3, §6.1: at least 4-5 coarse particles across the gap at a1, thesis case 7).
+ *
+ * Along the vertical line through x (in 3-D at z = 0, or the domain's middle z when 0 is
+ * outside it), between the domain's y-limits, the open space (behind no wall, sampled every
+ * dy and its ends found by bisection) that holds the most fluid of the geometry
+ * (lub_geometry_fluid_at: the fluid regions of particleGenDict.yaml, no wallGap) is the
+ * film.  When walls bound it below and above, h is the clearance between them (a cylinder of
+ * radius R over a plane: R - sqrt(R^2 - x^2) + h0 = h0 + x^2/(2R) + ...); when one side is
+ * the domain's edge (no upper wall at x: a free surface), h is the depth of the fluid in it,
+ * from its lowest to its highest point (the layer particleGen fills). */
+typedef enum {
+    LUB_GAP_NONE,  /* no fluid on the line */
+    LUB_GAP_WALLS, /* the clearance between two walls */
+    LUB_GAP_FLUID  /* no wall on one side: the fluid depth */
+} lub_gap_kind;
+
+typedef struct {
+    lub_gap_kind kind;
+    double h;             /* the clearance or the fluid depth [m] */
+    double ylo, yhi;      /* the open space's ends */
+    int wall_lo, wall_hi; /* walls (indices into the geometry) there, -1: the domain's edge */
+} lub_level_gap;
+
+void lub_levels_gap(const lub_geometry *g, double x, double dy, lub_level_gap *gap);
 
 /* One-line summary ("2 levels: l0 5e-06 [-0.0036, 0.003], 4e-05; Nr 8; overlap 0.0003 m"). */
 void lub_levels_describe(const lub_levels *L, char *buf, size_t size);

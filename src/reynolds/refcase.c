@@ -256,6 +256,30 @@ void lub_refgap_free(lub_refgap *G)
     G->h = G->hf = G->dhdt = NULL;
 }
 
+lub_reynolds_status lub_refcase_solve(const lub_refcase *rc, const lub_refgap *G, double *p,
+                                      lub_reynolds_result *res)
+{
+    const lub_refcase_settings *s = &rc->s;
+    lub_reynolds_problem pb;
+    lub_reynolds_problem_init(&pb);
+    pb.n = G->n;
+    pb.xa = G->xa;
+    pb.xb = G->xb;
+    pb.h = G->h;
+    pb.h_face = G->hf;
+    pb.u1 = rc->u1;
+    pb.u2 = rc->u2;
+    pb.dhdt_nodes = G->dhdt;
+    pb.mu = rc->mu;
+    pb.bc = (lub_reynolds_bc)s->bc;
+    pb.exit_x = s->exit_x;
+    pb.tolerance = s->tolerance;
+    pb.max_iterations = (int)s->max_iterations;
+    memset(res, 0, sizeof *res);
+    res->p = p;
+    return lub_reynolds_solve(&pb, res);
+}
+
 void lub_refcase_check_scales(const lub_refcase *rc)
 {
     if (rc->upper->type != LUB_WALL_CYLINDER)

@@ -30,6 +30,7 @@
 #include "io/case.h"
 #include "io/dict.h"
 #include "models/elastic.h"
+#include "reynolds/reynolds.h"
 
 /* softEHL.mode: auto (soft EHL exactly when constant/models.yaml has elasticWall), on
  * (required), off (the rigid reference even with an elasticWall). */
@@ -89,6 +90,12 @@ typedef struct {
  * does not span the interval or the gap is <= 0. */
 void lub_refgap_sample(lub_refgap *G, const lub_refcase *rc);
 void lub_refgap_free(lub_refgap *G);
+
+/* Solve the rigid reference on the gap G (the Reynolds equation with the case's U1, U2, mu,
+ * boundary condition, tolerance and iterations: what reynoldsRef solves without soft EHL):
+ * p receives the G->n + 1 nodal pressures, res the derived figures (reynolds.h). */
+lub_reynolds_status lub_refcase_solve(const lub_refcase *rc, const lub_refgap *G, double *p,
+                                      lub_reynolds_result *res);
 
 /* The thesis' scales (T-38, T-39): X = x/sx, P = p sp, H = h/h0. */
 typedef struct {

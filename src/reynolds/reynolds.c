@@ -461,3 +461,49 @@ lub_reynolds_status lub_reynolds_solve(const lub_reynolds_problem *pb, lub_reyno
     res->load = w * dx;
     return LUB_REYNOLDS_OK;
 }
+
+int lub_reynolds_inflections(int n, double xa, double xb, const double *p, double *xl, double *xr)
+{
+    if (n < 2) return -1;
+    const double dx = (xb - xa) / n;
+    int im = 0;
+    for (int i = 1; i <= n; i++)
+        if (p[i] > p[im]) im = i;
+    if (!(p[im] > 0.0)) return -1;
+#define D2(i) (p[(i)-1] - 2.0 * p[(i)] + p[(i) + 1])
+#define XN(i) ((i) == n ? xb : xa + (double)(i)*dx)
+    int found = 0;
+    /* upstream: from the peak towards the inlet */
+    *xl = xa;
+    for (int i = im - 1; i >= 1; i--) {
+        if (!(p[i] > 0.0)) {
+            *xl = XN(i);
+            break;
+        }
+        const double di = D2(i);
+        if (di > 0.0) {
+            const double dn = i + 1 <= n - 1 ? D2(i + 1) : 0.0; /* <= 0 unless i + 1 = im */
+            *xl = dn < 0.0 ? XN(i) + dx * di / (di - dn) : XN(i + 1);
+            found |= 1;
+            break;
+        }
+    }
+    /* downstream: from the peak towards the outlet */
+    *xr = xb;
+    for (int i = im + 1; i <= n - 1; i++) {
+        if (!(p[i] > 0.0)) {
+            *xr = XN(i);
+            break;
+        }
+        const double di = D2(i);
+        if (di > 0.0) {
+            const double dp = i - 1 >= 1 ? D2(i - 1) : 0.0; /* <= 0 unless i - 1 = im */
+            *xr = dp < 0.0 ? XN(i - 1) + dx * dp / (dp - di) : XN(i - 1);
+            found |= 2;
+            break;
+        }
+    }
+#undef D2
+#undef XN
+    return found;
+}

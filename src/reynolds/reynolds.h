@@ -95,6 +95,18 @@ void lub_reynolds_problem_init(lub_reynolds_problem *pb);
  * of the peak (linear interpolation), or xb if p stays positive. */
 lub_reynolds_status lub_reynolds_solve(const lub_reynolds_problem *pb, lub_reynolds_result *res);
 
+/* The inflection points of a pressure curve nearest its peak, one on each side (the
+ * multi-resolution start-up check: the thesis puts the fine/coarse boundary a1 upstream of
+ * the inflection point of the Reynolds pressure, methods.md §3).  p holds n + 1 values at the
+ * nodes of a uniform grid on [xa, xb]; the peak is the largest node value.  Going out from
+ * the peak, the second difference p_{i-1} - 2 p_i + p_{i+1} (negative at a smooth peak) first
+ * turns positive between two nodes: the inflection point is its zero there, by linear
+ * interpolation.  A side where the pressure falls to p <= 0 (the inlet, the free exit, a
+ * cavitated stretch) or reaches the grid's end first has none: *xl (*xr) then gets that
+ * end of the pressurised film.  Returns -1 when no node has p > 0 (nothing set), else a bit
+ * set: 1 when the upstream point (x < peak) was found, 2 the downstream one. */
+int lub_reynolds_inflections(int n, double xa, double xb, const double *p, double *xl, double *xr);
+
 /* Node coordinate i of the problem's grid. */
 static inline double lub_reynolds_node_x(const lub_reynolds_problem *pb, int i)
 {

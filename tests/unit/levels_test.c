@@ -163,28 +163,28 @@ static void test_wedge_locate(void)
         unsigned present, fixed, generate;
         int boundary;
     } t[] = {
-        {0.0, 0, 1, 0, 0, -1},           /* contact: fine only */
-        {-0.0050, 1, 2, 0, 0, -1},       /* inlet, upstream of the overlap: coarse only */
-        {0.0050, 1, 2, 0, 0, -1},        /* outlet */
-        {-0.003700, 1, 2, 0, 0, -1},     /* just upstream of the fine level's reach */
-        {-0.003658, 1, 3, 1, 1, 0},      /* fine generation layer (2 um from its edge) */
-        {-0.003650, 1, 3, 1, 0, 0},      /* fine band, not its generation layer */
-        {-0.003620, 1, 3, 0, 0, 0},      /* both free */
-        {-0.0036, 0, 3, 0, 0, 0},        /* a1 itself belongs to the fine level */
-        {-0.003450, 0, 3, 2, 0, 0},      /* coarse band (90 um from its edge) */
-        {-0.003390, 0, 3, 2, 2, 0},      /* coarse generation layer (30 um) */
-        {-0.003300, 0, 1, 0, 0, -1},     /* inside the coarse level's hole */
-        {0.002700, 0, 1, 0, 0, -1},      /* hole, outlet side */
-        {0.002790, 0, 3, 2, 2, 1},       /* coarse generation layer at a2 */
-        {0.002900, 0, 3, 2, 0, 1},       /* coarse band */
-        {0.003010, 1, 3, 0, 0, 1},       /* past a2: coarse owns, fine free */
-        {0.003050, 1, 3, 1, 0, 1},       /* fine band */
-        {0.003057, 1, 3, 1, 1, 1},       /* fine generation layer */
-        {0.003100, 1, 2, 0, 0, -1},      /* past the fine level's reach */
-        {0.0150, 1, 2, 0, 0, -1},        /* periodic: -0.005 + 0.02 */
-        {0.0199, 0, 1, 0, 0, -1},        /* -0.0001 + 0.02 */
-        {0.02, 0, 1, 0, 0, -1},          /* 0 + 0.02 */
-        {-0.0236, 0, 3, 0, 0, 0},        /* -0.0036 - 0.02: a1 */
+        {0.0, 0, 1, 0, 0, -1},       /* contact: fine only */
+        {-0.0050, 1, 2, 0, 0, -1},   /* inlet, upstream of the overlap: coarse only */
+        {0.0050, 1, 2, 0, 0, -1},    /* outlet */
+        {-0.003700, 1, 2, 0, 0, -1}, /* just upstream of the fine level's reach */
+        {-0.003658, 1, 3, 1, 1, 0},  /* fine generation layer (2 um from its edge) */
+        {-0.003650, 1, 3, 1, 0, 0},  /* fine band, not its generation layer */
+        {-0.003620, 1, 3, 0, 0, 0},  /* both free */
+        {-0.0036, 0, 3, 0, 0, 0},    /* a1 itself belongs to the fine level */
+        {-0.003450, 0, 3, 2, 0, 0},  /* coarse band (90 um from its edge) */
+        {-0.003390, 0, 3, 2, 2, 0},  /* coarse generation layer (30 um) */
+        {-0.003300, 0, 1, 0, 0, -1}, /* inside the coarse level's hole */
+        {0.002700, 0, 1, 0, 0, -1},  /* hole, outlet side */
+        {0.002790, 0, 3, 2, 2, 1},   /* coarse generation layer at a2 */
+        {0.002900, 0, 3, 2, 0, 1},   /* coarse band */
+        {0.003010, 1, 3, 0, 0, 1},   /* past a2: coarse owns, fine free */
+        {0.003050, 1, 3, 1, 0, 1},   /* fine band */
+        {0.003057, 1, 3, 1, 1, 1},   /* fine generation layer */
+        {0.003100, 1, 2, 0, 0, -1},  /* past the fine level's reach */
+        {0.0150, 1, 2, 0, 0, -1},    /* periodic: -0.005 + 0.02 */
+        {0.0199, 0, 1, 0, 0, -1},    /* -0.0001 + 0.02 */
+        {0.02, 0, 1, 0, 0, -1},      /* 0 + 0.02 */
+        {-0.0236, 0, 3, 0, 0, 0},    /* -0.0036 - 0.02: a1 */
     };
     int bad = 0;
     for (size_t i = 0; i < sizeof t / sizeof t[0]; i++) {
@@ -238,8 +238,7 @@ static void test_three_levels(void)
     lub_geometry g;
     read_geometry(&g, three_geo);
     lub_levels L;
-    read_levels(&L, "multiResolution: { overlap: { coarse: 2, fine: 3 }, fixedBand: 1.5 }\n",
-                &g);
+    read_levels(&L, "multiResolution: { overlap: { coarse: 2, fine: 3 }, fixedBand: 1.5 }\n", &g);
     CHECK(L.nlevels == 3 && !L.periodic);
     CHECK(L.level[0].nr == 2 && L.level[1].nr == 4 && L.level[2].nr == 1);
     CHECK(L.level[0].dt_factor == 1 && L.level[1].dt_factor == 2 && L.level[2].dt_factor == 8);
@@ -371,8 +370,8 @@ static void test_bad_input(void)
     CHECK_STR(test_last_error, "gives a single l0");
     BAD(wedge_geo, "multiResolution:\n  levels: [ {l0: 5e-6} ]\n", NULL, 2,
         "'levels' must list at least 2 levels, found 1");
-    BAD(wedge_geo, "multiResolution:\n  levels: [ {l0: 5e-6}, {l0: 4e-5}, {l0: 8e-5} ]\n", NULL,
-        2, "lists 3 levels but");
+    BAD(wedge_geo, "multiResolution:\n  levels: [ {l0: 5e-6}, {l0: 4e-5}, {l0: 8e-5} ]\n", NULL, 2,
+        "lists 3 levels but");
     /* restated levels that disagree with particleGenDict (or are not ordered) */
     BAD(wedge_geo, "multiResolution:\n  levels:\n    - {l0: 5e-6}\n    - {l0: 8e-5}\n", NULL, 4,
         "level 1 has l0 = 8e-05 here but l0 = 4e-05 in");
@@ -460,8 +459,9 @@ static void test_read_case(void)
     read_geometry(&g, three_geo);
     lub_particles P;
     lub_geometry_discretise(&g, &P, 0, NULL);
-    lub_dict *d = lub_dict_parse("constant/models.yaml",
-                                 "multiResolution: { overlap: { coarse: 2, fine: 3 }, fixedBand: 1.5 }\n");
+    lub_dict *d =
+        lub_dict_parse("constant/models.yaml",
+                       "multiResolution: { overlap: { coarse: 2, fine: 3 }, fixedBand: 1.5 }\n");
     lub_node *mr = lub_dict_map(lub_dict_root(d), "multiResolution");
     lub_levels L;
     lub_levels_read_case(&L, mr, geo_path, &P);
@@ -480,6 +480,57 @@ static void test_read_case(void)
     lub_geometry_free(&g);
 }
 
+/* The film across a boundary (lub_levels_gap): under the wedge's cylinder the clearance
+ * R - sqrt(R^2 - x^2) + h0 between the plane and the cylinder; without the cylinder the depth
+ * of the 80 um layer; where no fluid region reaches, none. */
+static void test_gap(void)
+{
+    lub_geometry g;
+    read_geometry(&g, wedge_geo);
+    const double R = 0.04, h0 = 4e-5;
+    const double xs[] = {-0.0036, 0.0030, 0.0, -0.0095};
+    for (size_t i = 0; i < sizeof xs / sizeof xs[0]; i++) {
+        const double x = xs[i], h = h0 + R - sqrt(R * R - x * x);
+        lub_level_gap gp;
+        lub_levels_gap(&g, x, 1.25e-6, &gp);
+        CHECK(gp.kind == LUB_GAP_WALLS);
+        CHECK(gp.wall_lo == 0 && gp.wall_hi == 1);
+        CHECK_NEAR(gp.h, h, 1e-15);
+        CHECK_NEAR(gp.ylo, 0.0, 1e-15);
+        printf("  x = %g: gap %.9g m (by hand %.9g), %.3f coarse particles across\n", x, gp.h, h,
+               gp.h / 4e-5);
+    }
+    lub_geometry_free(&g);
+
+    /* no cylinder: the layer's depth (the free surface at 80 um) */
+    char text[2048];
+    snprintf(text, sizeof text, "%s", wedge_geo);
+    char *cyl = strstr(text, "  cylinder:");
+    char *end = strstr(cyl, "fluid:");
+    memmove(cyl, end, strlen(end) + 1);
+    read_geometry(&g, text);
+    lub_level_gap gp;
+    lub_levels_gap(&g, -0.0036, 1.25e-6, &gp);
+    CHECK(gp.kind == LUB_GAP_FLUID);
+    CHECK(gp.wall_lo == 0 && gp.wall_hi == -1);
+    CHECK_NEAR(gp.h, 8e-5, 1e-15);
+    CHECK_NEAR(gp.yhi, 1.4e-3, 1e-15);
+    lub_geometry_free(&g);
+
+    /* a box of fluid away from x: none */
+    snprintf(text, sizeof text, "%s", wedge_geo);
+    char *layer = strstr(text, "  - { type: layer");
+    snprintf(layer, sizeof text - (size_t)(layer - text),
+             "  - { type: box, min: [0.005, 0], max: [0.008, 5e-5] }\n");
+    read_geometry(&g, text);
+    lub_levels_gap(&g, -0.0036, 1.25e-6, &gp);
+    CHECK(gp.kind == LUB_GAP_NONE);
+    lub_levels_gap(&g, 0.006, 1.25e-6, &gp); /* the box under the cylinder */
+    CHECK(gp.kind == LUB_GAP_WALLS);
+    CHECK_NEAR(gp.h, h0 + R - sqrt(R * R - 0.006 * 0.006), 1e-15);
+    lub_geometry_free(&g);
+}
+
 int main(void)
 {
     RUN(test_wedge_round_trip);
@@ -489,6 +540,7 @@ int main(void)
     RUN(test_time_weight);
     RUN(test_bad_input);
     RUN(test_read_case);
+    RUN(test_gap);
     unlink(geo_path);
     return test_summary();
 }

@@ -557,6 +557,41 @@ static void test_bad_input(void)
     setup_free(&s);
 }
 
+/* Inflection points: of exp(-x^2) at -/+ 1/sqrt(2) (second order in dx); none on either side
+ * of the parabola 1 - x^2 (the ends of the film instead); none of a curve nowhere positive. */
+static void test_inflections(void)
+{
+    enum { N = 6000 };
+    static double p[N + 1];
+    const double xa = -3.0, xb = 3.0, dx = (xb - xa) / N;
+    for (int i = 0; i <= N; i++) {
+        double x = xa + i * dx;
+        p[i] = exp(-x * x);
+    }
+    double xl = 0, xr = 0;
+    CHECK(lub_reynolds_inflections(N, xa, xb, p, &xl, &xr) == 3);
+    CHECK_NEAR(xl, -sqrt(0.5), 1e-5);
+    CHECK_NEAR(xr, sqrt(0.5), 1e-5);
+    /* shifted: the peak off the grid's middle */
+    for (int i = 0; i <= N; i++) {
+        double x = xa + i * dx - 0.5;
+        p[i] = exp(-x * x);
+    }
+    CHECK(lub_reynolds_inflections(N, xa, xb, p, &xl, &xr) == 3);
+    CHECK_NEAR(xl, 0.5 - sqrt(0.5), 1e-5);
+    CHECK_NEAR(xr, 0.5 + sqrt(0.5), 1e-5);
+    /* concave everywhere, zero at -1 and 1, cavitated (0) beyond 1 */
+    for (int i = 0; i <= N; i++) {
+        double x = -1.0 + i * (3.0 / N);
+        p[i] = x < 1.0 ? 1.0 - x * x : 0.0;
+    }
+    CHECK(lub_reynolds_inflections(N, -1.0, 2.0, p, &xl, &xr) == 0);
+    CHECK(xl == -1.0);
+    CHECK_NEAR(xr, 1.0, 3.0 / N);
+    for (int i = 0; i <= N; i++) p[i] = -1.0;
+    CHECK(lub_reynolds_inflections(N, xa, xb, p, &xl, &xr) == -1);
+}
+
 int main(void)
 {
     (void)test_last_error;
@@ -570,5 +605,6 @@ int main(void)
     RUN(test_rupture_and_reformation);
     RUN(test_rupture_fine_grid);
     RUN(test_bad_input);
+    RUN(test_inflections);
     return test_summary();
 }

@@ -1,8 +1,8 @@
 /* lubFoam: the semi-implicit MPS solver (methods.md §1-2).
  *
  * Reads the case's dictionaries and the particles of the start time, checks the stability
- * limits, then advances in time, writing time folders and function-object tables, and
- * reports what the run cost.
+ * limits (and, multi-resolution, the fine/coarse boundaries: lubFoamChecks.c), then advances
+ * in time, writing time folders and function-object tables, and reports what the run cost.
  */
 #include <errno.h>
 #include <math.h>
@@ -302,7 +302,9 @@ int main(int argc, char **argv)
             "  then the last good state.",
         .dictionaries = "system/controlDict.yaml\nsystem/particleGenDict.yaml (domain)\n"
                         "system/schemes.yaml\nsystem/solution.yaml (optional)\n"
-                        "constant/transportProperties.yaml\nconstant/models.yaml",
+                        "constant/transportProperties.yaml\nconstant/models.yaml\n"
+                        "system/reynoldsRefDict.yaml (optional: multiResolution start-up "
+                        "check)",
         .has_case = 1,
         .min_args = 0,
         .max_args = 0,
@@ -343,12 +345,13 @@ int main(int argc, char **argv)
         lub_mps_init(&r.mps, &r.P, &cfg, geo.dmin, geo.dmax, geo.periodic);
         lubfoam_read_elastic(&r, &geo);
     }
-    lub_geometry_free(&geo);
     lubfoam_functions *fos = lubfoam_functions_read(&r);
     lub_dict_finish(r.ctl.dict);
 
     print_header(&r);
     check_limits(&r);
+    lubfoam_check_levels(&r, &geo);
+    lub_geometry_free(&geo);
 
     signal(SIGINT, on_signal);
     signal(SIGTERM, on_signal);

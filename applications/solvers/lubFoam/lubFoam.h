@@ -49,6 +49,12 @@ void lubfoam_read_elastic(lubfoam_run *r, const lub_geometry *geo);
 /* Write the current state as a time folder (atomic), update particles.xdmf, purge. */
 void lubfoam_write(lubfoam_run *r);
 
+/* Multi-resolution start-up checks (lubFoamChecks.c; nothing without r->opt): for every
+ * fine/coarse boundary, the coarse particles across the film there (at least 4-5) and its
+ * place against the inflection points of the Reynolds pressure of
+ * system/reynoldsRefDict.yaml.  Warnings only. */
+void lubfoam_check_levels(const lubfoam_run *r, const lub_geometry *geo);
+
 /* Function objects (controlDict `functions`). */
 typedef struct lubfoam_functions lubfoam_functions;
 lubfoam_functions *lubfoam_functions_read(lubfoam_run *r);

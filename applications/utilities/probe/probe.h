@@ -16,6 +16,7 @@
 #include "io/dict.h"
 #include "io/table.h"
 #include "models/elastic.h"
+#include "mps/levels.h"
 #include "reynolds/refcase.h"
 
 typedef enum {
@@ -108,6 +109,8 @@ typedef struct {
     int ew_state;     /* constant/models.yaml elasticWall: 0 not read, 1 read, -1 none */
     lub_dict *models; /* owns ew's nodes */
     lub_elastic_wall ew;
+    int levels_state; /* constant/models.yaml multiResolution: 0 not read, 1 read, -1 none */
+    lub_levels levels;
 } probe_ctx;
 
 void probe_ctx_free(probe_ctx *x);

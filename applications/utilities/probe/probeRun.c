@@ -87,6 +87,53 @@ static const lub_elastic_wall *ctx_elastic(probe_ctx *x)
     return x->ew_state > 0 ? &x->ew : NULL;
 }
 
+/* The resolution levels of a multi-resolution case (mps/levels.h), read as the solver reads
+ * them (constant/models.yaml multiResolution against system/particleGenDict.yaml, checked
+ * against the particles P: fatal with file:line when they disagree), or NULL when
+ * models.yaml has no multiResolution entry. */
+static const lub_levels *ctx_levels(probe_ctx *x, const lub_particles *P)
+{
+    if (x->levels_state == 0) {
+        char path[LUB_PATH_MAX], geo[LUB_PATH_MAX];
+        x->levels_state = -1;
+        lub_dict *d = lub_dict_read_optional(lub_case_path(&x->c, path, "constant/models.yaml"));
+        if (!d) return NULL;
+        lub_node *root = lub_dict_root(d);
+        lub_models_declare(root);
+        lub_node *mr = lub_dict_find(root, "multiResolution");
+        if (mr) {
+            lub_levels_read_case(&x->levels, mr,
+                                 lub_case_path(&x->c, geo, "system/particleGenDict.yaml"), P);
+            x->levels_state = 1;
+        }
+        lub_dict_free(d);
+    }
+    return x->levels_state > 0 ? &x->levels : NULL;
+}
+
+/* M^0 of a multi-resolution run (T-27): the multiResolution mass0 of the first of the times
+ * whose uniform/state.yaml has one (lubFoam writes the run's M^0 there), into *m0 and the
+ * time's name into from; 0 when none has. */
+static int state_mass0(const lub_case *c, const lub_time *times, size_t nt, double *m0, char *from,
+                       size_t size)
+{
+    for (size_t i = 0; i < nt; i++) {
+        char path[LUB_PATH_MAX];
+        lub_dict *d =
+            lub_dict_read_optional(lub_case_pathf(c, path, "%s/uniform/state.yaml", times[i].name));
+        if (!d) continue;
+        lub_node *mr = lub_dict_map_or(lub_dict_root(d), "multiResolution");
+        int found = mr && lub_dict_has(mr, "mass0");
+        if (found) {
+            *m0 = lub_dict_real(mr, "mass0", LUB_NONNEGATIVE);
+            snprintf(from, size, "%s/uniform/state.yaml", times[i].name);
+        }
+        lub_dict_free(d);
+        if (found) return 1;
+    }
+    return 0;
+}
+
 static double ctx_rho(probe_ctx *x)
 {
     if (!x->have_rho) {
@@ -784,21 +831,76 @@ static void run_shape(job *j)
 
 /* ---- totals: one row per time --------------------------------------------------------- */
 
+/* Multi-resolution totals (T-27): each fluid particle counted where its level owns x, with
+ * the particle mass of its level, as lubFoam's totals function object counts them. */
+static void owned_totals(const lub_particles *P, const lub_levels *L, double rho, lub_totals *t,
+                         size_t owned[LUB_MAX_LEVELS])
+{
+    double su[LUB_MAX_LEVELS][3] = {{0}}, su2[LUB_MAX_LEVELS] = {0};
+    memset(t, 0, sizeof *t);
+    for (int k = 0; k < LUB_MAX_LEVELS; k++) owned[k] = 0;
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->kind[i] != LUB_FLUID) continue;
+        const int k = P->level[i];
+        lub_level_where w;
+        lub_levels_locate(L, P->x[0][i], &w);
+        if (w.owner != k) continue;
+        owned[k]++;
+        for (int d = 0; d < P->dim; d++) {
+            su[k][d] += P->u[d][i];
+            su2[k] += P->u[d][i] * P->u[d][i];
+        }
+    }
+    for (int k = 0; k < L->nlevels; k++) {
+        const double m = rho * pow(L->level[k].l0, P->dim);
+        t->nfluid += owned[k];
+        t->mass += m * (double)owned[k];
+        for (int d = 0; d < 3; d++) t->momentum[d] += m * su[k][d];
+        t->kinetic += 0.5 * m * su2[k];
+    }
+}
+
 static void run_totals(job *j)
 {
     double rho = ctx_rho(j->x);
-    enum { NFIX = 7, NC = 9 };
+    enum { NFIX = 7, NC = NFIX + 3 + LUB_MAX_LEVELS };
     double sum[NC] = {0};
     int dim = 2, nc = NFIX;
     /* -patch: the load on the patch; loadMean when it is the elastic wall */
     const lub_elastic_wall *e = j->s->patch ? ctx_elastic(j->x) : NULL;
     int mean = e && strcmp(e->patch_name, j->s->patch) == 0;
     if (j->s->patch) nc += 1 + mean;
+    /* multi-resolution: the mass error against M^0 and the particles of each level */
+    const lub_levels *L = NULL;
+    const int mcol = nc;
+    double mass0 = NAN;
+    char mass0_from[LUB_PATH_MAX + 64] = "";
+    int have_state = 0;
     for (size_t it = 0; it < j->nt; it++) {
         job_read(j, it);
         dim = j->P.dim;
         lub_totals t;
-        lub_totals_compute(&t, &j->P, rho);
+        size_t owned[LUB_MAX_LEVELS];
+        if (it == 0 && j->P.nlevels > 1) {
+            L = ctx_levels(j->x, &j->P);
+            if (!L)
+                lub_warning("%s has %d resolution levels but constant/models.yaml has no "
+                            "'multiResolution' entry: the totals count every fluid particle of "
+                            "every level (an overlap twice)",
+                            j->file, j->P.nlevels);
+            else {
+                nc += 1 + L->nlevels;
+                have_state =
+                    state_mass0(&j->x->c, j->times, j->nt, &mass0, mass0_from, sizeof mass0_from);
+            }
+        }
+        if (L && j->P.nlevels != L->nlevels)
+            lub_fatal("%s has %d resolution levels but the first time selected, %s, has %d",
+                      j->file, j->P.nlevels, j->times[0].name, L->nlevels);
+        if (L)
+            owned_totals(&j->P, L, rho, &t, owned);
+        else
+            lub_totals_compute(&t, &j->P, rho);
         double row[NC] = {j->times[it].value, t.mass,    t.momentum[0],   t.momentum[1],
                           t.momentum[2],      t.kinetic, (double)t.nfluid};
         if (j->s->patch) {
@@ -817,16 +919,43 @@ static void run_totals(job *j)
             row[NFIX + 1] = 0.0;
             if (mean && pm) lub_wall_integral(&j->P, patch, pm, &row[NFIX + 1]);
         }
+        if (L) {
+            if (it == 0 && !have_state) {
+                mass0 = t.mass;
+                snprintf(mass0_from, sizeof mass0_from,
+                         "the mass at the first time selected, %s (no uniform/state.yaml with "
+                         "multiResolution mass0 in the times selected)",
+                         j->times[0].name);
+            }
+            row[mcol] = mass0 > 0 ? 100.0 * (t.mass / mass0 - 1.0) : 0.0;
+            for (int k = 0; k < L->nlevels; k++) row[mcol + 1 + k] = (double)owned[k];
+        }
         lub_particles_free(&j->P);
         if (it == 0) {
-            char h[512];
-            snprintf(h, sizeof h, "%s%s%s",
-                     dim == 2 ? "t[s] mass[kg/m] momentumX[kg/s] momentumY[kg/s] "
-                                "momentumZ[kg/s] kineticEnergy[J/m] fluidParticles"
-                              : "t[s] mass[kg] momentumX[kg*m/s] momentumY[kg*m/s] "
-                                "momentumZ[kg*m/s] kineticEnergy[J] fluidParticles",
-                     j->s->patch ? " load[N/m]" : "", mean ? " loadMean[N/m]" : "");
+            char h[1024];
+            int len = snprintf(h, sizeof h, "%s%s%s",
+                               dim == 2 ? "t[s] mass[kg/m] momentumX[kg/s] momentumY[kg/s] "
+                                          "momentumZ[kg/s] kineticEnergy[J/m] fluidParticles"
+                                        : "t[s] mass[kg] momentumX[kg*m/s] momentumY[kg*m/s] "
+                                          "momentumZ[kg*m/s] kineticEnergy[J] fluidParticles",
+                               j->s->patch ? " load[N/m]" : "", mean ? " loadMean[N/m]" : "");
+            if (L) {
+                len += snprintf(h + len, sizeof h - (size_t)len, " massError[%%]");
+                for (int k = 0; k < L->nlevels; k++)
+                    len += snprintf(h + len, sizeof h - (size_t)len, " fluidLevel%d", k);
+            }
             probe_block_begin(&j->b, h, nc);
+            if (L) {
+                probe_block_comment(&j->b,
+                                    "multiResolution, %d levels: mass, momentum, kineticEnergy "
+                                    "and fluidParticles count each fluid particle where its "
+                                    "level owns x (T-27: each point of space on one level), "
+                                    "fluidLevel<k> those of level k",
+                                    L->nlevels);
+                probe_block_comment(&j->b, "massError = 100 (mass / M0 - 1), M0 = %.17g %s: %s%s",
+                                    mass0, dim == 2 ? "kg/m" : "kg", have_state ? "mass0 of " : "",
+                                    mass0_from);
+            }
         }
         if (j->s->average)
             for (int c = 0; c < nc; c++) sum[c] += row[c];

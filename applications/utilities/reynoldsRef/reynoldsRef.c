@@ -142,25 +142,10 @@ int main(int argc, char **argv)
         return 0;
     }
 
-    lub_reynolds_problem pb;
-    lub_reynolds_problem_init(&pb);
-    pb.n = G.n;
-    pb.xa = G.xa;
-    pb.xb = G.xb;
-    pb.h = G.h;
-    pb.h_face = G.hf;
-    pb.u1 = rc.u1;
-    pb.u2 = rc.u2;
-    pb.dhdt_nodes = G.dhdt;
-    pb.mu = rc.mu;
-    pb.bc = (lub_reynolds_bc)s->bc;
-    pb.exit_x = s->exit_x;
-    pb.tolerance = s->tolerance;
-    pb.max_iterations = (int)s->max_iterations;
     double *p = lub_malloc((size_t)(G.n + 1) * sizeof *p);
-    lub_reynolds_result res = {.p = p};
+    lub_reynolds_result res;
     double t_solve = lub_wtime();
-    lub_reynolds_status st = lub_reynolds_solve(&pb, &res);
+    lub_reynolds_status st = lub_refcase_solve(&rc, &G, p, &res);
     t_solve = lub_wtime() - t_solve;
     if (st != LUB_REYNOLDS_OK)
         lub_fatal_run("the Reynolds solve failed: %s (%d cells on [%g, %g], %s)",

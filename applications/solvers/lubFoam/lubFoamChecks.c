@@ -1,0 +1,207 @@
+/* lubFoam: start-up checks of a multi-resolution case's fine/coarse boundaries (methods.md §3,
+ * thesis §2-2 and case 7 of §3), printed after the Courant and diffusion numbers.  They warn
+ * (stderr, "lubFoam: warning: ...") and never stop the run: a boundary in a bad place gives
+ * poor results, not a failure.  For every boundary a (a1, a2 of mps/levels.h):
+ *
+ *   1. the film across x = a, in coarse particles: the clearance between the walls there (or,
+ *      without an upper wall, the depth of the fluid particleGen fills; lub_levels_gap)
+ *      divided by the coarse level's l0.  Fewer than 4 is a warning: the thesis lost the inlet
+ *      film with too few coarse particles across the gap at a1 (Nr = 16) and asks for 4-5.
+ *
+ *   2. the Reynolds pressure there, when the case has system/reynoldsRefDict.yaml: the rigid
+ *      reference is solved as reynoldsRef solves it (milliseconds), and a boundary between
+ *      the inflection points of p(x) on each side of its peak (where the pressure is high)
+ *      is a warning: the thesis puts a1 upstream of the inflection point.  Without the
+ *      dictionary one line says that the check is skipped; a dictionary reynoldsRef would
+ *      reject, or a failed solve, is a warning naming the problem, and the run goes on.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "core/error.h"
+#include "core/timer.h"
+#include "geometry/geometry.h"
+#include "lubFoam.h"
+#include "reynolds/refcase.h"
+#include "reynolds/reynolds.h"
+
+/* The thesis' rule: at least 4-5 coarse particles across the gap at a1 (methods.md §3). */
+#define MIN_ACROSS 4.0
+
+/* "a1" / "a2" (with more than two levels: "a1 of level k"). */
+static void boundary_name(const lub_levels *L, const lub_level_boundary *b, char *buf, size_t size)
+{
+    if (L->nlevels == 2)
+        snprintf(buf, size, "a%d", b->side + 1);
+    else
+        snprintf(buf, size, "a%d of level %d", b->side + 1, b->fine);
+}
+
+/* 1. coarse particles across the film at each boundary */
+static void check_gaps(const lub_levels *L, const lub_geometry *g)
+{
+    for (int i = 0; i < L->nboundaries; i++) {
+        const lub_level_boundary *b = &L->boundary[i];
+        const double l0 = L->level[b->coarse].l0;
+        char name[64];
+        boundary_name(L, b, name, sizeof name);
+        lub_level_gap gp;
+        lub_levels_gap(g, b->x, 0.25 * L->level[0].l0, &gp);
+        if (gp.kind == LUB_GAP_NONE) {
+            lub_message("multiResolution: no fluid at %s = %g m in system/particleGenDict.yaml: "
+                        "the film across it is not checked",
+                        name, b->x);
+            continue;
+        }
+        const double across = gp.h / l0;
+        char what[256];
+        if (gp.kind == LUB_GAP_WALLS)
+            snprintf(what, sizeof what, "the gap (between '%s' and '%s')",
+                     g->walls[gp.wall_lo].name, g->walls[gp.wall_hi].name);
+        else
+            snprintf(what, sizeof what, "the fluid depth (no %s wall there)",
+                     gp.wall_hi < 0 ? "upper" : "lower");
+        char fix[96] = "";
+        if (gp.kind == LUB_GAP_WALLS) snprintf(fix, sizeof fix, "move %s outward or ", name);
+        if (across < MIN_ACROSS * (1 - 1e-9))
+            lub_warning("multiResolution: at the boundary %s = %g m %s is %.3g m, %.2f coarse "
+                        "particles across (l0 %g); the thesis needs at least 4-5 (methods.md 3): "
+                        "%slower Nr",
+                        name, b->x, what, gp.h, across, l0, fix);
+        else
+            lub_message("multiResolution: at %s = %g m %s is %.3g m: %.2f coarse particles "
+                        "across (l0 %g; at least 4-5 needed, methods.md 3)",
+                        name, b->x, what, gp.h, across, l0);
+    }
+}
+
+/* The rigid Reynolds reference of the case, as reynoldsRef solves it. */
+typedef struct {
+    lub_refcase rc;
+    lub_refgap G;
+    double *p;
+    lub_reynolds_result res;
+    lub_reynolds_status st;
+} reference;
+
+static void reference_solve(reference *f, const lub_case *c)
+{
+    lub_refcase_read(&f->rc, c);
+    if (f->rc.ehl) return; /* lubFoam refuses elasticWall with multiResolution */
+    lub_refgap_sample(&f->G, &f->rc);
+    f->p = lub_malloc((size_t)(f->G.n + 1) * sizeof *f->p);
+    f->st = lub_refcase_solve(&f->rc, &f->G, f->p, &f->res);
+}
+
+/* p at x by linear interpolation on the reference's grid (x inside it). */
+static double reference_p(const reference *f, double x)
+{
+    const lub_refgap *G = &f->G;
+    double s = (x - G->xa) / G->dx;
+    int i = (int)floor(s);
+    if (i < 0) i = 0;
+    if (i > G->n - 1) i = G->n - 1;
+    s -= i;
+    return (1 - s) * f->p[i] + s * f->p[i + 1];
+}
+
+/* 2. the boundaries against the Reynolds pressure's inflection points */
+static void check_reynolds(const lub_levels *L, const lub_case *c)
+{
+    char path[LUB_PATH_MAX];
+    struct stat st;
+    if (stat(lub_case_path(c, path, "system/reynoldsRefDict.yaml"), &st) != 0) {
+        lub_message("multiResolution: no system/reynoldsRefDict.yaml: the boundaries are not "
+                    "checked against the Reynolds pressure (a1 upstream of its inflection "
+                    "point, methods.md 3)");
+        return;
+    }
+    /* errors of the reference's dictionaries become a warning; what they allocated before
+     * the error is left (once, at start-up) */
+    reference *f = lub_calloc(1, sizeof *f);
+    double t0 = lub_wtime();
+    lub_catcher catcher;
+    if (lub_error_catch(&catcher) == 0) {
+        reference_solve(f, c);
+        lub_error_uncatch();
+    } else {
+        lub_warning("multiResolution: the boundaries are not checked against the Reynolds "
+                    "pressure: its reference cannot be built (reynoldsRef would stop): %s",
+                    catcher.message);
+        return;
+    }
+    t0 = lub_wtime() - t0;
+    if (f->rc.ehl) {
+        lub_message("multiResolution: the Reynolds reference is soft EHL: the boundaries are "
+                    "not checked against its pressure");
+    } else if (f->st != LUB_REYNOLDS_OK) {
+        lub_warning("multiResolution: the boundaries are not checked against the Reynolds "
+                    "pressure: the solve of system/reynoldsRefDict.yaml failed: %s (%d cells "
+                    "on [%g, %g] m, %s)",
+                    lub_reynolds_status_string(f->st), f->G.n, f->G.xa, f->G.xb,
+                    lub_reynolds_bc_names[f->rc.s.bc]);
+    } else {
+        double xl, xr;
+        int found = lub_reynolds_inflections(f->G.n, f->G.xa, f->G.xb, f->p, &xl, &xr);
+        /* for the messages: round-off about x = 0 printed as 0 */
+        const double tiny = 1e-9 * (f->G.xb - f->G.xa);
+        if (fabs(xl) < tiny) xl = 0.0;
+        if (fabs(xr) < tiny) xr = 0.0;
+        if (found < 0) {
+            lub_warning("multiResolution: the boundaries are not checked against the Reynolds "
+                        "pressure: it is nowhere positive (system/reynoldsRefDict.yaml, %d cells "
+                        "on [%g, %g] m)",
+                        f->G.n, f->G.xa, f->G.xb);
+        } else {
+            char sl[96], sr[96];
+            snprintf(sl, sizeof sl, "%.4g m%s", xl,
+                     found & 1 ? "" : " (none on this side: the end of the film)");
+            snprintf(sr, sizeof sr, "%.4g m%s", xr,
+                     found & 2 ? "" : " (none on this side: the end of the film)");
+            lub_message("multiResolution: Reynolds reference (system/reynoldsRefDict.yaml, %d "
+                        "cells on [%g, %g] m, %s; %.3g s): peak %.4g Pa at x = %.4g m, "
+                        "inflection points of p(x) at x = %s and %s",
+                        f->G.n, f->G.xa, f->G.xb, lub_reynolds_bc_names[f->rc.s.bc], t0,
+                        f->res.p_max, f->res.x_max, sl, sr);
+            for (int i = 0; i < L->nboundaries; i++) {
+                const lub_level_boundary *b = &L->boundary[i];
+                char name[64];
+                boundary_name(L, b, name, sizeof name);
+                if (b->x < f->G.xa || b->x > f->G.xb) {
+                    lub_message("multiResolution: %s = %g m lies outside the reference's [%g, "
+                                "%g] m, away from its pressure",
+                                name, b->x, f->G.xa, f->G.xb);
+                    continue;
+                }
+                const double pc = 100.0 * reference_p(f, b->x) / f->res.p_max;
+                if (b->x > xl && b->x < xr)
+                    lub_warning("multiResolution: the boundary %s = %g m lies where the "
+                                "Reynolds pressure is high, between the inflection points "
+                                "x = %.4g and %.4g m on each side of its peak (%.4g Pa at "
+                                "x = %.4g m; system/reynoldsRefDict.yaml): p there is %.1f%% of "
+                                "the peak; the thesis puts a1 upstream of the inflection point "
+                                "(methods.md 3): move %s outward",
+                                name, b->x, xl, xr, f->res.p_max, f->res.x_max, pc, name);
+                else
+                    lub_message("multiResolution: %s = %g m lies outside the high-pressure "
+                                "zone between the inflection points: p there is %.1f%% of the "
+                                "peak",
+                                name, b->x, pc);
+            }
+        }
+    }
+    free(f->p);
+    lub_refgap_free(&f->G);
+    lub_refcase_free(&f->rc);
+    free(f);
+}
+
+void lubfoam_check_levels(const lubfoam_run *r, const lub_geometry *geo)
+{
+    if (!r->opt) return;
+    check_gaps(&r->opt->L, geo);
+    check_reynolds(&r->opt->L, &r->cs);
+}
