@@ -123,11 +123,20 @@ static void check_supported(const lub_levels *L, lub_node *mr, lub_node *root)
     if (L->nlevels > 2)
         lub_node_error(mr, "multiResolution: %d levels: this version of lubFoam runs 2 levels",
                        L->nlevels);
+    /* the elastic wall across levels (mps/elastic_wall.h) moves every level's wall each step
+     * from one deformation: every level takes the same steps (T-60) */
     lub_node *ew = lub_dict_find(root, "elasticWall");
-    if (ew)
-        lub_node_error(ew, "model 'elasticWall' with 'multiResolution' is not available in this "
-                           "version of lubFoam: the elastic wall across levels (T-62..T-65) is "
-                           "still to come");
+    int nr = 1;
+    for (int k = 0; k < L->nlevels - 1; k++)
+        if (L->level[k].nr > nr) nr = L->level[k].nr;
+    if (ew && nr > 1)
+        lub_node_error(ew,
+                       "model 'elasticWall' with 'multiResolution' needs one time step on every "
+                       "level: add 'commonDeltaT: true' to multiResolution (%s:%d; it sub-steps "
+                       "with Nr %d): the wall is deformed and moved before every step of every "
+                       "level from one pressure field (thesis T-60: dt_coarse = dt_fine)",
+                       lub_node_file(mr) ? lub_node_file(mr) : "constant/models.yaml",
+                       lub_node_line(mr), nr);
 }
 
 static void read_models(lub_mps_config *c, const char *path, const char *geometry_path,

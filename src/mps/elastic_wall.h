@@ -90,11 +90,48 @@
  * moves).
  *
  * Crossing.  The step is refused (LUB_STEP_ESCAPED, the solver writes the state and exits
- * 2) when a wall particle would come closer than l0/2 to the surface beneath it.
+ * 2) when a wall particle would come closer than l0/2 (l0 of its level) to the surface
+ * beneath it.
  *
- * Cost: one evaluation of the influence coefficients (dense: nw^2 multiply-adds) and O(nw +
- * nd) work per step; the particle-index map of the slots is rebuilt (O(N + n log n)) only
- * when the solver has reordered the particles.  No allocation after lub_mps_elastic_init.
+ * Multi-resolution (thesis 4-3, T-60..T-67; lub_mps_elastic_init_levels with the levels'
+ * solvers of mps/opt.h).  Every level has its own wall and dummy particles of the patch in
+ * its extended region, the overlaps included, and keeps its own slots, dummy interpolation
+ * (between its own wall slots) and running means.  What couples them:
+ *   - the pressure segments, the sources of T-46, count each point of x once: they are the
+ *     wall particles of the level that owns their x (lub_levels_locate's owner: the fine
+ *     level inside [a1, a2], the coarse one outside), sorted by x, with the half-way widths
+ *     of lub_elastic_segment_widths over them: each level's own spacing inside its part
+ *     (l_oj of T-62, T-64; l0 cos theta on the arc), an intermediate width for the two
+ *     segments where the levels meet, so that the segments tile x.  Each coefficient is
+ *     T-46 with the segment's own width (models/elastic.h: a coarse segment equals the fine
+ *     segments it covers).  T-62 as printed sums over all N = N_fine + N_coarse wall
+ *     particles, which would count the overlaps, where both levels have walls, twice;
+ *   - the displacement is evaluated at every wall particle of every level, the overlaps
+ *     included, from those segments: both levels' walls take one shape, to the linear
+ *     interpolation between their particles (tests/cases/softEHLOPT: a fine wall particle
+ *     of an overlap lies within 0.02 l0_fine of the coarse wall, within the derived bound);
+ *   - the load L of T-51 is the same owned sum (T-66, T-67: the integral over the fine region
+ *     plus that over the coarse region), so one h0 moves the wall of every level;
+ *   - each level's wall particles average their own pressure (pWallMean) after each step;
+ *     the means of those that do not own their x (in the overlaps) are kept, not used.
+ * Every level takes the same steps (commonDeltaT, T-60; lub_mps_config_read refuses
+ * sub-stepping with the elastic wall, file:line): the wall is deformed and moved before each
+ * step of all levels from one displacement, as in the thesis, which chose one dt so that the
+ * deformation would not lose accuracy.  The multi-resolution driver keeps walls still
+ * (mps.h still_walls) except the patches a model moves (patch_moved), whose particles move
+ * with the velocity given here, vertically, keeping their x: each level's part of the wall
+ * stays in the level's part of x.  As the wall moves away from where the geometry puts it,
+ * the driver's generation cells leave the wall out and skip the cells behind it
+ * (lub_opt_moving_wall, which lubFoam calls after the set-up).  Exact restart: the file is
+ * split into the levels in the same order, and the slots, segments and coefficients are
+ * rebuilt from the particles' x.  The header line of lubFoam lists each level's wall and
+ * dummy particles and pressure segments.
+ *
+ * Cost: one evaluation of the influence coefficients (dense: nw^2 multiply-adds; multi-
+ * resolution: all wall particles times the owned ones) and O(nw + nd) work per step; the
+ * particle-index map of the slots is rebuilt (O(N + n log n)) only when the solver has
+ * reordered (or, multi-resolution, compacted) the particles.  No allocation after
+ * lub_mps_elastic_init.
  */
 #ifndef LUB_MPS_ELASTIC_WALL_H
 #define LUB_MPS_ELASTIC_WALL_H
@@ -105,7 +142,24 @@
 #include "geometry/geometry.h"
 #include "io/dict.h"
 #include "models/elastic.h"
+#include "mps/levels.h"
 #include "mps/mps.h"
+
+/* The patch's particles on one resolution level (single resolution: the only one). */
+typedef struct {
+    lub_mps *m; /* the level's solver; the particles are m->P */
+    double l0;
+    int nw, nd;           /* wall slots k < nw sorted by x (ties by id), dummies q < nd */
+    int t0;               /* the wall slots are the kernel's targets t0 .. t0 + nw - 1 */
+    double *xw, *floor;   /* x and the surface beneath, per wall slot */
+    uint64_t *ids;        /* ids of the patch particles (walls by slot, then dummies) */
+    size_t *idx;          /* their particle index (idx[k], idx[nw + q]) */
+    uint64_t *sorted_id;  /* ids sorted, with ... */
+    int *sorted_slot;     /* ... the slot of each */
+    int *da;              /* dummy q: wall slots da[q], da[q] + 1 ... */
+    double *df;           /* ... with weight 1 - df[q], df[q] */
+    double *mean, *shape; /* the particle fields pWallMean, elasticShape */
+} lub_mps_elastic_level;
 
 typedef struct {
     lub_dict *dict;          /* constant/models.yaml (owns e's nodes) */
@@ -113,8 +167,8 @@ typedef struct {
     void *tmp_pts, *tmp_ids; /* set-up only: sort buffers */
     lub_elastic_wall e;      /* the entry (h0^0 = e.h0; e.patch_name is patch_name) */
     char patch_name[LUB_NAME_MAX];
-    int patch; /* patch index in the particles */
-    double l0;
+    int patch;      /* patch index in the particles (the same on every level) */
+    double l0;      /* of the finest level */
     double y_floor; /* y_f: surface beneath the lowest point */
 
     /* state */
@@ -122,21 +176,23 @@ typedef struct {
     long samples;       /* pressure samples in the running mean */
     double target_mean; /* the load W(t) in the same running mean */
 
-    /* the patch: wall slots k < nw sorted by x, dummies q < nd */
-    int nw, nd;
-    double *xw, *ww, *floor; /* x, segment width, surface beneath, per wall slot */
-    uint64_t *ids;           /* ids of all patch particles (walls by slot, then dummies) */
-    size_t *idx;             /* their particle index (idx[k], idx[nw + q]) */
-    uint64_t *sorted_id;     /* ids sorted, with ... */
-    int *sorted_slot;        /* ... the slot of each */
-    int *da;                 /* dummy q: wall slots da[q], da[q] + 1 ... */
-    double *df;              /* ... with weight 1 - df[q], df[q] */
-    int kc;                  /* x_c between slots kc, kc + 1 with weight fc */
-    double fc;
-    double *pw, *v; /* mean pressure gathered by slot; displacement by slot */
+    /* the patch on each level */
+    int nlevels;
+    lub_mps_elastic_level lv[LUB_MAX_LEVELS];
+    int nw, nd; /* wall and dummy particles of all levels */
+
+    /* the pressure segments (T-46, T-62): the wall slots whose x their level owns, each
+     * point of x on one level, sorted by x; the kernel's sources */
+    int ns;
+    int *src_level, *src_slot; /* level and wall slot of segment s */
+    double *xs, *ws;           /* its x and width */
+    double *pw;                /* the mean pressure gathered by segment */
+    double *xt, *v;            /* the kernel's targets (every wall slot of every level, level by
+                                  level) and their displacement */
+    int lc, kc; /* x_c between wall slots kc, kc + 1 of level lc (which owns x_c) ... */
+    double fc;  /* ... with weight fc */
     lub_elastic_kernel *K;
-    double *mean, *shape; /* the particle fields */
-    double weight;        /* 2 / (N + 1) */
+    double weight; /* 2 / (N + 1) */
 
     /* figures of the last step */
     double load;         /* integral of the mean wall pressure [N/m] */
@@ -156,21 +212,29 @@ typedef struct {
  * in the particles or reaches above the cylinder's centre, moves (movingWalls), the ramp is
  * longer than the run, the particles hold the model's fields but the state has no
  * elasticWall entry (or the reverse), or the start position puts the wall within l0/2 of the
- * surface beneath. */
+ * surface beneath.  The solver m is kept (not owned) for the steps. */
 int lub_mps_elastic_init(lub_mps_elastic *w, lub_mps *m, const lub_geometry *g,
                          const char *models_path, const char *state_path, double end_time,
                          const char *end_what);
+
+/* The same for a multi-resolution run: the solvers m[0 .. nlevels) of the levels L (mps/opt.h
+ * o->m, o->L), every level with its own wall and dummy particles of the patch (see
+ * Multi-resolution above).  With nlevels 1 and L NULL it is lub_mps_elastic_init.  Fatal, as
+ * that, also when a level has dummy particles of the patch but no wall particles. */
+int lub_mps_elastic_init_levels(lub_mps_elastic *w, lub_mps *const *m, int nlevels,
+                                const lub_levels *L, const lub_geometry *g, const char *models_path,
+                                const char *state_path, double end_time, const char *end_what);
 void lub_mps_elastic_free(lub_mps_elastic *w);
 
-/* Before the step from t to t + dt: load balance, displacement, target positions and the
- * wall velocities.  LUB_STEP_ESCAPED with a message (and the state unchanged) when the wall
- * would come within l0/2 of the surface beneath. */
-lub_step_status lub_mps_elastic_before(lub_mps_elastic *w, lub_mps *m, double t, double dt,
-                                       char *msg, size_t msgsize);
+/* Before the step from t to t + dt (every level's): load balance, displacement, target
+ * positions and the wall velocities.  LUB_STEP_ESCAPED with a message (and the state
+ * unchanged) when the wall would come within l0/2 (of its level) of the surface beneath. */
+lub_step_status lub_mps_elastic_before(lub_mps_elastic *w, double t, double dt, char *msg,
+                                       size_t msgsize);
 
-/* After the step (the time is now t): the wall pressure enters the running mean; the figures
- * (load, load_target = W(t), ...) are updated. */
-void lub_mps_elastic_after(lub_mps_elastic *w, lub_mps *m, double t);
+/* After the step (the time is now t): the wall pressure of each level enters the running mean
+ * of its particles; the figures (load, load_target = W(t), ...) are updated. */
+void lub_mps_elastic_after(lub_mps_elastic *w, double t);
 
 /* load / load_target - 1: the error of the mean load against W(t) (0 when W is 0). */
 double lub_mps_elastic_beta(const lub_mps_elastic *w);

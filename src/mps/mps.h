@@ -90,7 +90,9 @@ typedef struct {
     int fixed_flags; /* allocate lub_mps.fixed: particles whose velocity and pressure are given */
     int still_walls; /* wall and dummy particles keep their positions while carrying their
                         patch velocity: every wall is at rest or a plane sliding along itself,
-                        so that the walls of a level stay in the part of x the level covers */
+                        so that the walls of a level stay in the part of x the level covers;
+                        except on the patches a model moves (patch_moved), whose particles move
+                        with the velocity it gives them (elasticWall: vertically, x kept) */
 } lub_mps_config;
 
 /* The defaults of every entry (those of etc/templates/schemes.yaml and solution.yaml). */

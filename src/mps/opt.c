@@ -133,7 +133,8 @@ static double surface_fraction(int dim, double re_l0)
 
 /* The generation cells of level k (opt.h, lub_opt_transfer): the level's lattice points in
  * its generation layers, one l0 wide inside each edge of its extended region beyond which
- * another level lies (locate's `generate`), where particleGen's rules allow fluid. */
+ * another level lies (locate's `generate`), where particleGen's rules allow fluid; the walls
+ * that a model moves (o->moved, lub_opt_moving_wall) are left out of those rules. */
 static void generation_cells(lub_opt *o, const lub_geometry *g, int k)
 {
     const lub_levels *L = &o->L;
@@ -157,6 +158,13 @@ static void generation_cells(lub_opt *o, const lub_geometry *g, int k)
     for (int d = 0; d < 3; d++) box.min[d] = g->dmin[d], box.max[d] = g->dmax[d];
     any.nregions = 1;
     any.regions = &box;
+    lub_wall walls[LUB_MAX_PATCHES];
+    any.nwalls = 0;
+    any.walls = walls;
+    for (int i = 0; i < g->nwalls && any.nwalls < LUB_MAX_PATCHES; i++) {
+        int p = lub_particles_find_patch(&o->P[k], g->walls[i].name);
+        if (p < 0 || !o->moved[p]) walls[any.nwalls++] = g->walls[i];
+    }
     size_t cap = 0;
     for (int m = 0; m < n; m++) {
         lub_particles R;
@@ -177,7 +185,8 @@ static void generation_cells(lub_opt *o, const lub_geometry *g, int k)
     o->gen_val[k] = lub_calloc(7 * m, sizeof(double));
 }
 
-/* Every moving wall must be a plane sliding along itself (opt.h, Walls). */
+/* Every moving wall must be a plane sliding along itself, or moved by a model that keeps x
+ * (opt.h, Walls). */
 static void check_walls(const lub_particles *P, const lub_mps_config *c, const lub_geometry *g)
 {
     for (int p = 0; p < P->npatches; p++) {
@@ -185,10 +194,9 @@ static void check_walls(const lub_particles *P, const lub_mps_config *c, const l
         const lub_wall *w = NULL;
         for (int i = 0; i < g->nwalls; i++)
             if (strcmp(g->walls[i].name, P->patch_names[p]) == 0) w = &g->walls[i];
-        if (c->patch_moved[p])
-            lub_fatal("multiResolution: the wall '%s' is moved by a model (elasticWall): a "
-                      "multi-resolution run does not support it yet",
-                      P->patch_names[p]);
+        /* a wall moved by a model keeps its particles' x (elasticWall: vertically only;
+         * mps.h still_walls), so each level's part of it stays in the level's part of x */
+        if (c->patch_moved[p]) continue;
         const double s = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
         if (!(s > 0)) continue;
         double vn = 0;
@@ -334,6 +342,21 @@ void lub_opt_free(lub_opt *o)
     }
     free(o->cand);
     memset(o, 0, sizeof *o);
+}
+
+void lub_opt_moving_wall(lub_opt *o, const lub_geometry *g, int patch)
+{
+    if (patch < 0 || patch >= LUB_MAX_PATCHES) lub_bug("lub_opt_moving_wall: patch %d", patch);
+    if (o->moved[patch]) return;
+    o->moved[patch] = 1;
+    for (int k = 0; k < o->nlevels; k++) {
+        free(o->gen[k]);
+        free(o->gen_ok[k]);
+        free(o->gen_val[k]);
+        o->gen[k] = NULL;
+        o->ngen[k] = 0;
+        generation_cells(o, g, k);
+    }
 }
 
 size_t lub_opt_capacity(const lub_opt *o)
@@ -700,10 +723,13 @@ static int decide(lub_opt *o, int A, const double c[3], double dt, const blend *
     for (int d = 0; d < dim; d++) period[d] = o->lsq[A].period[d];
     int cells[3][3], nc[3];
 
-    /* nearest particle of A: leave the cell alone while one is within half a cell */
+    /* nearest particle of A: leave the cell alone while one is within half a cell; and the
+     * nearest of its wall and dummy particles: a dummy of a wall a model moves puts the cell
+     * behind that wall (lub_opt_moving_wall) */
     const lub_neighbours *na = &o->src[A];
     const lub_particles *PA = &o->P[A];
-    double d2min = INFINITY;
+    double d2min = INFINITY, d2wall = INFINITY;
+    size_t jwall = 0;
     cells_around(na, dim, c, cells, nc);
     for (int a = 0; a < nc[0]; a++)
         for (int b = 0; b < nc[1]; b++)
@@ -717,9 +743,11 @@ static int decide(lub_opt *o, int A, const double c[3], double dt, const blend *
                         r2 += v * v;
                     }
                     if (r2 < d2min) d2min = r2;
+                    if (PA->kind[j] != LUB_FLUID && r2 < d2wall) d2wall = r2, jwall = j;
                 }
             }
     if (d2min < 0.25 * l0 * l0) return 0;
+    if (d2wall < INFINITY && PA->kind[jwall] == LUB_DUMMY && o->moved[PA->patch[jwall]]) return 0;
 
     /* the other level's fluid fills the cell: PND of its fluid against the room its walls
      * leave (T-4 sums at c), in the state nearer in time */

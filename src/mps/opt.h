@@ -40,8 +40,15 @@
  * Walls.  A level's walls must stay in the part of x the level covers, so in a multi-
  * resolution run the wall and dummy particles keep their positions (mps.h still_walls) and
  * only carry their patch velocity: every wall must be at rest or a plane sliding along itself
- * (movingWalls), which is translation invariant.  Other moving walls (and elasticWall) are
- * refused at set-up.
+ * (movingWalls), which is translation invariant.  Other moving walls are refused at set-up.
+ * The exception is a wall that a model moves while keeping its particles' x (mps.h
+ * patch_moved): the elastic wall (mps/elastic_wall.h, Multi-resolution), whose particles on
+ * every level move vertically with the one displacement computed from the wall pressure of
+ * the levels owning each x (T-62..T-67), before each step of every level (commonDeltaT:
+ * the configuration refuses sub-stepping with it).  Its band particles (T-25, T-26) take
+ * the other level's pressure like any wall particle's; lub_opt_moving_wall takes the
+ * generation cells again without it and skips the cells behind it, since the wall leaves the
+ * place where the geometry puts it.
  *
  * Particles.  particleGen generates each level only in the part of x it owns; at set-up each
  * level's overlap margins are filled from the geometry (lub_geometry_discretise_range) when
@@ -165,6 +172,7 @@ typedef struct {
 
     double rho;   /* density (the mass of T-27) */
     double mass0; /* M^0 of the mass correction (set-up: the mass of the particles given) */
+    uint8_t moved[LUB_MAX_PATCHES]; /* walls a model moves (lub_opt_moving_wall) */
 } lub_opt;
 
 /* Set up from the particles P of all levels (not modified; its arrays are copied), the levels
@@ -177,6 +185,14 @@ typedef struct {
 void lub_opt_init(lub_opt *o, const lub_levels *L, const lub_particles *P, const lub_mps_config *c,
                   const lub_geometry *g, double headroom);
 void lub_opt_free(lub_opt *o);
+
+/* The wall `patch` (index in the particles) is moved by a model (elasticWall, after
+ * lub_opt_init; mps.h patch_moved): its particles leave the place where the geometry g puts
+ * the wall, so the generation cells are taken again without it (the lattice points of the
+ * generation layers where the other walls allow fluid, also those the wall covered at the
+ * start), and a cell whose nearest wall or dummy particle of the level is a dummy of that
+ * wall lies behind it and is skipped (lub_opt_transfer). */
+void lub_opt_moving_wall(lub_opt *o, const lub_geometry *g, int patch);
 
 /* One step of length dt on every level: flags the fixed bands, interpolates their velocity
  * and pressure from the other level, then lub_mps_step on each level, then the particle

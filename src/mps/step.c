@@ -871,16 +871,19 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     if (viscosity(m, dt, msg, msgsize)) return LUB_STEP_SOLVE_FAILED;
 
     /* 3. temporary positions (T-8); with still_walls only the fluid moves (the walls are at
-     * rest or slide along themselves: their particles carry the velocity in place) */
+     * rest or slide along themselves: their particles carry the velocity in place), and the
+     * walls a model moves (patch_moved: elasticWall, vertically) */
     lub_timer_start(&m->tm, LUB_T_OTHER);
     for (int d = 0; d < dim; d++) {
         double *x = P->x[d];
         const double *us = m->us[d];
         if (m->c.still_walls) {
             const uint8_t *kind = P->kind;
+            const uint16_t *patch = P->patch;
+            const int *moved = m->c.patch_moved;
 #pragma omp parallel for schedule(static)
             for (size_t i = 0; i < n; i++)
-                if (kind[i] == LUB_FLUID) x[i] += us[i] * dt;
+                if (kind[i] == LUB_FLUID || moved[patch[i]]) x[i] += us[i] * dt;
         } else {
 #pragma omp parallel for schedule(static)
             for (size_t i = 0; i < n; i++) x[i] += us[i] * dt;

@@ -19,16 +19,30 @@ static int curve_cmp(const void *a, const void *b)
     return (u->id > v->id) - (u->id < v->id);
 }
 
-size_t lub_wall_curve(const lub_particles *P, int patch, size_t **idx)
+/* particleGen's owner of x (geometry.h levels; mps/levels.h lub_levels_locate) */
+static int owner(const lub_geometry *g, double x)
+{
+    for (int k = 0; k < g->nlevels - 1; k++)
+        if (g->levels[k].has_region && x >= g->levels[k].xmin && x <= g->levels[k].xmax) return k;
+    return g->nlevels - 1;
+}
+
+/* Wall particle i of patch on the curve (see wallshape.h). */
+static int on_curve(const lub_particles *P, int patch, const lub_geometry *g, size_t i)
+{
+    if (P->kind[i] != LUB_WALL || (int)P->patch[i] != patch) return 0;
+    if (!g || P->nlevels < 2 || g->nlevels != P->nlevels) return 1;
+    return owner(g, P->x[0][i]) == P->level[i];
+}
+
+size_t lub_wall_curve(const lub_particles *P, int patch, const lub_geometry *g, size_t **idx)
 {
     size_t n = 0;
-    for (size_t i = 0; i < P->n; i++)
-        if (P->kind[i] == LUB_WALL && (int)P->patch[i] == patch) n++;
+    for (size_t i = 0; i < P->n; i++) n += on_curve(P, patch, g, i);
     curve_pt *c = lub_malloc((n ? n : 1) * sizeof *c);
     n = 0;
     for (size_t i = 0; i < P->n; i++)
-        if (P->kind[i] == LUB_WALL && (int)P->patch[i] == patch)
-            c[n++] = (curve_pt){P->x[0][i], P->id[i], i};
+        if (on_curve(P, patch, g, i)) c[n++] = (curve_pt){P->x[0][i], P->id[i], i};
     qsort(c, n, sizeof *c, curve_cmp);
     *idx = lub_malloc((n ? n : 1) * sizeof **idx);
     for (size_t k = 0; k < n; k++) (*idx)[k] = c[k].i;
@@ -36,10 +50,11 @@ size_t lub_wall_curve(const lub_particles *P, int patch, size_t **idx)
     return n;
 }
 
-int lub_wall_integral(const lub_particles *P, int patch, const double *f, double *out)
+int lub_wall_integral(const lub_particles *P, int patch, const lub_geometry *g, const double *f,
+                      double *out)
 {
     size_t *idx;
-    size_t n = lub_wall_curve(P, patch, &idx);
+    size_t n = lub_wall_curve(P, patch, g, &idx);
     *out = 0.0;
     if (n == 0) {
         free(idx);
@@ -63,7 +78,7 @@ size_t lub_wall_shape(const lub_particles *P, int patch, const lub_geometry *g,
                       const lub_elastic_wall *e, double h0, lub_wall_shape_row **rows)
 {
     size_t *idx;
-    size_t n = lub_wall_curve(P, patch, &idx);
+    size_t n = lub_wall_curve(P, patch, g, &idx);
     const double *shape = lub_particles_find_extra(P, LUB_ELASTIC_FIELD_SHAPE);
     double yf;
     if (!lub_elastic_floor(g, e, e->x_centre, &yf)) yf = e->y_lowest - e->h0;

@@ -10,6 +10,13 @@
  * (half-way to each neighbour), exactly the sum the elasticWall model balances against its
  * load (mps/elastic_wall.h).
  *
+ * Multi-resolution (particles of several levels, and the geometry g of
+ * system/particleGenDict.yaml with the same levels): every level has its own wall particles
+ * in the overlaps, so the curve is made of the wall particles in the part of x their level
+ * owns (particleGen's ownership: the first level whose region holds x, else the last; as
+ * mps/levels.h), each point of x once, as the elasticWall model counts its load.  Without g
+ * (or with a single level) every wall particle of the patch is on the curve.
+ *
  * The elastic wall (models/elastic.h, mps/elastic_wall.h) puts wall particle k at
  *
  *     y_k = y_f + h0 + s_k + v_k                                                    (T-50)
@@ -32,13 +39,15 @@
 #include "models/elastic.h"
 #include "particles/particles.h"
 
-/* The wall particles (kind wall) of patch, sorted by x (ties by id): their indices into
- * *idx (allocated; free it).  Returns the count. */
-size_t lub_wall_curve(const lub_particles *P, int patch, size_t **idx);
+/* The wall particles (kind wall) of patch on the curve (see above; g may be NULL), sorted by
+ * x (ties by id): their indices into *idx (allocated; free it).  Returns the count. */
+size_t lub_wall_curve(const lub_particles *P, int patch, const lub_geometry *g, size_t **idx);
 
-/* sum_k f_k w_k over the wall particles of patch (see above) into *out.  Returns 0, or -1
- * when two of them share an x (the patch is not a graph y(x)); *out = 0 without particles. */
-int lub_wall_integral(const lub_particles *P, int patch, const double *f, double *out);
+/* sum_k f_k w_k over the wall particles of the curve of patch (see above; g may be NULL) into
+ * *out.  Returns 0, or -1 when two of them share an x (the patch is not a graph y(x)); *out =
+ * 0 without particles. */
+int lub_wall_integral(const lub_particles *P, int patch, const lub_geometry *g, const double *f,
+                      double *out);
 
 typedef struct {
     double x, y, v, h; /* see above */
@@ -46,8 +55,9 @@ typedef struct {
 } lub_wall_shape_row;
 
 /* The shape of the elastic wall e (its patch's index in P: patch) at rigid-body position
- * h0, one row per wall particle sorted by x, into *rows (allocated; free it); g is the
- * geometry e was read against.  h is NAN where no surface lies beneath.  Returns the count. */
+ * h0, one row per wall particle of the curve sorted by x, into *rows (allocated; free it); g
+ * is the geometry e was read against.  h is NAN where no surface lies beneath.  Returns the
+ * count. */
 size_t lub_wall_shape(const lub_particles *P, int patch, const lub_geometry *g,
                       const lub_elastic_wall *e, double h0, lub_wall_shape_row **rows);
 

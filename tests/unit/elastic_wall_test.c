@@ -9,7 +9,12 @@
  *     each particle to its target in one step (velocity = dy/dt); a second update with the
  *     same mean moves the whole patch by dh0 only;
  *   - the mean update after a step, the crossing check (the state unchanged), the restart
- *     state, and bad input.
+ *     state, and bad input;
+ *   - two resolution levels (T-62..T-65): the pressure segments are the wall particles whose
+ *     x their level owns, once each, tiling x; every wall particle of both levels (the
+ *     overlaps included) goes to T-50 with the displacement of those segments only (the
+ *     others carry a mean pressure of 1e9 Pa, which must not matter); the load is the owned
+ *     sum, and each level's mean takes its own wall pressure.
  *
  * The particles come from the geometry module as particleGen makes them: a cylinder of
  * R = 1 mm over a plane, l0 = 10 um.
@@ -22,7 +27,9 @@
 #include "geometry/discretise.h"
 #include "geometry/geometry.h"
 #include "mps/elastic_wall.h"
+#include "mps/levels.h"
 #include "mps/mps.h"
+#include "mps/opt.h"
 #include "test.h"
 
 static const char *geom_text = "dimension: 2\n"
@@ -165,7 +172,7 @@ static void test_wall_update(void)
     w.target_mean = 40.0; /* the averaged load target (state) */
     double dh0 = lub_elastic_dh0(&w.e, L, 40.0);
     CHECK(dh0 > 0); /* L > W: the wall rises */
-    CHECK(lub_mps_elastic_before(&w, &s.m, t, dt, msg, sizeof msg) == LUB_STEP_OK);
+    CHECK(lub_mps_elastic_before(&w, t, dt, msg, sizeof msg) == LUB_STEP_OK);
     CHECK(w.h0 == h00 + dh0);
     double vmax = 0;
     for (int k = 0; k < nw; k++) {
@@ -199,7 +206,7 @@ static void test_wall_update(void)
         if (P->kind[i] != LUB_FLUID && P->patch[i] == cyl) P->x[1][i] += P->u[1][i] * dt;
     /* same mean again: the shape holds, the patch moves by the new dh0: dy/dt = dh0/dt */
     double h0a = w.h0;
-    CHECK(lub_mps_elastic_before(&w, &s.m, t, dt, msg, sizeof msg) == LUB_STEP_OK);
+    CHECK(lub_mps_elastic_before(&w, t, dt, msg, sizeof msg) == LUB_STEP_OK);
     double dh0b = w.h0 - h0a;
     CHECK_NEAR(dh0b, dh0, 1e-20);
     for (size_t i = 0; i < P->n; i++)
@@ -209,7 +216,7 @@ static void test_wall_update(void)
     /* after the step: the mean takes the step's wall pressure with weight 2/(N + 1) */
     const double a = 2.0 / 11.0;
     for (size_t i = 0; i < P->n; i++) P->p[i] = 1.0e5;
-    lub_mps_elastic_after(&w, &s.m, t + dt);
+    lub_mps_elastic_after(&w, t + dt);
     CHECK(w.samples == 1);
     for (int k = 0; k < nw; k++) CHECK_NEAR(mean[idx[k]], ps[k] + a * (1.0e5 - ps[k]), 1e-9);
     double Lm = 0, Li = 0;
@@ -232,7 +239,7 @@ static void test_wall_update(void)
         P->id[j] = tid, P->kind[j] = tk, P->patch[j] = tpa;
     }
     double load_before = w.load;
-    lub_mps_elastic_after(&w, &s.m, t + 2 * dt);
+    lub_mps_elastic_after(&w, t + 2 * dt);
     CHECK_NEAR(w.load, load_before + a * (Li - load_before), 1e-9 * Li);
 
     free(idx);
@@ -261,7 +268,7 @@ static void test_crossing(void)
     w.target_mean = 100.0;
     double *u = malloc(P->n * sizeof *u);
     memcpy(u, P->u[1], P->n * sizeof *u);
-    CHECK(lub_mps_elastic_before(&w, &s.m, 0.0, 1e-7, msg, sizeof msg) == LUB_STEP_ESCAPED);
+    CHECK(lub_mps_elastic_before(&w, 0.0, 1e-7, msg, sizeof msg) == LUB_STEP_ESCAPED);
     CHECK_STR(msg, "within");
     CHECK_STR(msg, "l0/2");
     CHECK(w.h0 == w.e.h0);
@@ -281,8 +288,8 @@ static void test_restart_state(void)
     char msg[256];
     for (size_t i = 0; i < s.P.n; i++) s.P.p[i] = 2.0e4;
     for (int k = 0; k < 5; k++) {
-        CHECK(lub_mps_elastic_before(&w, &s.m, k * 1e-7, 1e-7, msg, sizeof msg) == LUB_STEP_OK);
-        lub_mps_elastic_after(&w, &s.m, (k + 1) * 1e-7);
+        CHECK(lub_mps_elastic_before(&w, k * 1e-7, 1e-7, msg, sizeof msg) == LUB_STEP_OK);
+        lub_mps_elastic_after(&w, (k + 1) * 1e-7);
     }
     char state[] = "/tmp/lubewsXXXXXX";
     write_file(state, "time: 5.0e-7\nstep: 5\ndeltaT: 1.0e-7\n");
@@ -340,6 +347,174 @@ static void test_bad_input(void)
     setup_free(&s);
 }
 
+/* ---- multi-resolution ------------------------------------------------------------------- */
+
+/* The cylinder over the plane with two levels (fine 10 um owns [-0.2, 0.2] mm, coarse 20 um
+ * the rest of the 1.2 mm period; overlaps 6 x 20 + 12 x 10 = 240 um at each boundary). */
+static const char *geom_levels = "dimension: 2\n"
+                                 "levels:\n"
+                                 "  - { l0: 1.0e-5, region: [-2.0e-4, 2.0e-4] }\n"
+                                 "  - { l0: 2.0e-5 }\n"
+                                 "domain: { min: [-6.0e-4, -6.0e-5], max: [6.0e-4, 3.0e-4] }\n"
+                                 "periodic: [x]\n"
+                                 "walls:\n"
+                                 "  lowerWall: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+                                 "  cylinder:  { type: cylinder, lowestPoint: [0, 4.0e-5], "
+                                 "radius: 1.0e-3, range: [-6.0e-4, 6.0e-4] }\n"
+                                 "fluid:\n"
+                                 "  - { type: layer, wall: lowerWall, thickness: 2.0e-5 }\n";
+
+/* A Hertz-like mean pressure of half-width 70 um (inside the fine level's part that no
+ * overlap reaches, |x| < 80 um). */
+static double hertz_like(double x)
+{
+    double q = 1.0 - (x / 7.0e-5) * (x / 7.0e-5);
+    return q > 0 ? 4.0e5 * sqrt(q) : 0.0;
+}
+
+/* The elastic wall across two levels (T-62..T-65): the pressure segments are the wall
+ * particles whose x their level owns, each x once, with the half-way widths (the levels'
+ * spacings inside their parts); the displacement is evaluated at every wall particle of both
+ * levels (the overlaps included) from those segments only, so both levels' walls take one
+ * shape; the load is the same owned sum; each level's mean takes its own wall pressure. */
+static void test_levels(void)
+{
+    lub_geometry g;
+    lub_particles P0;
+    memset(&P0, 0, sizeof P0);
+    char gpath[] = "/tmp/lubewgXXXXXX";
+    write_file(gpath, geom_levels);
+    lub_geometry_read(&g, gpath);
+    unlink(gpath);
+    lub_geometry_discretise(&g, &P0, 0, NULL);
+    lub_dict *md =
+        lub_dict_parse("constant/models.yaml", "multiResolution: { commonDeltaT: true }\n");
+    lub_levels L;
+    lub_levels_read(&L, lub_dict_map(lub_dict_root(md), "multiResolution"), &g);
+    lub_dict_finish(md);
+    lub_dict_free(md);
+    lub_mps_config c;
+    lub_mps_config_defaults(&c);
+    c.rho = 810;
+    c.nu = 4.5e-4;
+    lub_opt o;
+    lub_opt_init(&o, &L, &P0, &c, &g, 0.0);
+    char models[] = "/tmp/lubewmXXXXXX";
+    write_file(models, models_ok);
+    lub_mps *ms[2] = {&o.m[0], &o.m[1]};
+    lub_mps_elastic w;
+    CHECK(lub_mps_elastic_init_levels(&w, ms, 2, &o.L, &g, models, NULL, 1e-3, "endTime") == 1);
+    const int cyl = w.patch;
+    CHECK(w.nlevels == 2 && o.m[0].c.patch_moved[cyl] && o.m[1].c.patch_moved[cyl]);
+
+    /* every wall particle of a level is a target; the owned ones are the segments, once */
+    int nw[2] = {0, 0}, nown = 0;
+    for (int k = 0; k < 2; k++)
+        for (size_t i = 0; i < o.P[k].n; i++) {
+            if (o.P[k].kind[i] != LUB_WALL || o.P[k].patch[i] != cyl) continue;
+            nw[k]++;
+            lub_level_where lw;
+            lub_levels_locate(&o.L, o.P[k].x[0][i], &lw);
+            nown += lw.owner == k;
+        }
+    CHECK(w.lv[0].nw == nw[0] && w.lv[1].nw == nw[1] && w.nw == nw[0] + nw[1]);
+    CHECK(w.ns == nown && nown < w.nw && nw[0] > 40 && nw[1] > 20);
+    double wsum = 0;
+    for (int s = 0; s < w.ns; s++) {
+        const lub_mps_elastic_level *l = &w.lv[w.src_level[s]];
+        lub_level_where lw;
+        lub_levels_locate(&o.L, w.xs[s], &lw);
+        CHECK(lw.owner == w.src_level[s] && l->xw[w.src_slot[s]] == w.xs[s]);
+        if (s > 0) CHECK(w.xs[s] > w.xs[s - 1]);
+        wsum += w.ws[s];
+    }
+    /* the half-way widths tile x from the first to the last segment */
+    CHECK_NEAR(wsum, w.xs[w.ns - 1] - w.xs[0] + 0.5 * (w.ws[0] + w.ws[w.ns - 1]), 1e-15);
+
+    /* a mean pressure on the owned wall particles, garbage on the others (never read) */
+    double *xs = malloc((size_t)w.ns * sizeof *xs), *ps = malloc((size_t)w.ns * sizeof *ps);
+    double Lsum = 0;
+    for (int k = 0; k < 2; k++) {
+        lub_particles *P = &o.P[k];
+        double *mean = lub_particles_find_extra(P, "pWallMean");
+        for (size_t i = 0; i < P->n; i++) {
+            if (P->kind[i] != LUB_WALL || P->patch[i] != cyl) continue;
+            lub_level_where lw;
+            lub_levels_locate(&o.L, P->x[0][i], &lw);
+            mean[i] = lw.owner == k ? hertz_like(P->x[0][i]) : 1.0e9;
+        }
+    }
+    for (int s = 0; s < w.ns; s++) {
+        xs[s] = w.xs[s];
+        ps[s] = hertz_like(xs[s]);
+        Lsum += ps[s] * w.ws[s];
+    }
+    const double t = 5.0e-5, dt = 2.5e-7, h00 = w.h0, base0 = w.y_floor + h00;
+    w.target_mean = 40.0;
+    const double dh0 = lub_elastic_dh0(&w.e, Lsum, 40.0);
+    char msg[512];
+    CHECK(lub_mps_elastic_before(&w, t, dt, msg, sizeof msg) == LUB_STEP_OK);
+    CHECK(w.h0 == h00 + dh0);
+    /* each wall particle of each level goes to T-50 with v from the owned segments */
+    double vmax = 0;
+    for (int k = 0; k < 2; k++) {
+        lub_particles *P = &o.P[k];
+        const double *shape = lub_particles_find_extra(P, "elasticShape");
+        for (size_t i = 0; i < P->n; i++) {
+            if (P->kind[i] != LUB_WALL || P->patch[i] != cyl) continue;
+            double x = P->x[0][i], v;
+            lub_elastic_displacement_direct(w.ns, xs, w.ws, 1, &x, w.e.E, w.e.b, ps, &v);
+            CHECK_NEAR(P->x[1][i] + P->u[1][i] * dt, base0 + dh0 + shape[i] + v, 1e-16);
+            vmax = fmax(vmax, fabs(v));
+        }
+    }
+    CHECK(vmax > 1e-7);
+    /* one shape: a fine and a coarse wall particle at the same x in an overlap would be at
+     * the same height (T-50 with one h0 and one v: checked above at every particle); the
+     * overlaps hold both levels' walls */
+    int nover = 0;
+    for (int q = 0; q < w.lv[0].nw; q++) {
+        lub_level_where lw;
+        lub_levels_locate(&o.L, w.lv[0].xw[q], &lw);
+        nover += lw.present == 3u && lw.owner == 1;
+    }
+    CHECK(nover > 10); /* fine wall particles where the coarse level owns x */
+
+    /* after the step: each level's mean takes its own wall pressure; the load is owned */
+    const double a = 2.0 / 11.0;
+    for (int k = 0; k < 2; k++)
+        for (size_t i = 0; i < o.P[k].n; i++) o.P[k].p[i] = (k + 1) * 1.0e5;
+    lub_mps_elastic_after(&w, t + dt);
+    double Lm = 0, Li = 0;
+    for (int s = 0; s < w.ns; s++) {
+        const int k = w.src_level[s];
+        const double pk = (k + 1) * 1.0e5;
+        Lm += (ps[s] + a * (pk - ps[s])) * w.ws[s];
+        Li += pk * w.ws[s];
+    }
+    for (int k = 0; k < 2; k++) {
+        const lub_mps_elastic_level *l = &w.lv[k];
+        const double *mean = lub_particles_find_extra(&o.P[k], "pWallMean");
+        for (int q = 0; q < l->nw; q++) {
+            const double x = l->xw[q];
+            lub_level_where lw;
+            lub_levels_locate(&o.L, x, &lw);
+            const double m0 = lw.owner == k ? hertz_like(x) : 1.0e9;
+            CHECK_NEAR(mean[l->idx[q]], m0 + a * ((k + 1) * 1.0e5 - m0), 1e-9 * fabs(m0) + 1e-9);
+        }
+    }
+    CHECK_NEAR(w.load, Lm, 1e-9 * Lm);
+    CHECK_NEAR(w.load_instant, Li, 1e-9 * Li);
+
+    free(xs);
+    free(ps);
+    lub_mps_elastic_free(&w);
+    unlink(models);
+    lub_opt_free(&o);
+    lub_particles_free(&P0);
+    lub_geometry_free(&g);
+}
+
 int main(void)
 {
     RUN(test_mean_window);
@@ -347,5 +522,6 @@ int main(void)
     RUN(test_crossing);
     RUN(test_restart_state);
     RUN(test_bad_input);
+    RUN(test_levels);
     return test_summary();
 }

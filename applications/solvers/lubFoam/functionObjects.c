@@ -12,14 +12,15 @@
  *              fluid particles in the part of x their level owns, each point of space on one
  *              level (T-27), with the mass rho l0^d of its level)
  * p.dat:       # x p n   wall pressure of the patch averaged over the window and the bin
- *              (n: samples); rewritten at every write time and at the end, with a second
- *              line "# samples S steps from t = A to t = B" (the steps averaged so far).
- *              A run restarted inside the window continues the average: it reads the p.dat
- *              of an earlier start whose last sample is the step it restarts from (sum =
- *              p n per bin, exact to round-off) and writes the whole window's mean under its
- *              own start time.  If no such table exists (the earlier run was stopped between
- *              writing its time folder and its table, or the table was deleted) it says so
- *              and averages from its start time only.
+ *              (n: samples; multi-resolution: the wall particles in the part of x their
+ *              level owns, as the elasticWall load); rewritten at every write time and at
+ *              the end, with a second line "# samples S steps from t = A to t = B" (the
+ *              steps averaged so far).  A run restarted inside the window continues the
+ *              average: it reads the p.dat of an earlier start whose last sample is the step
+ *              it restarts from (sum = p n per bin, exact to round-off) and writes the whole
+ *              window's mean under its own start time.  If no such table exists (the earlier
+ *              run was stopped between writing its time folder and its table, or the table
+ *              was deleted) it says so and averages from its start time only.
  * The cost table (postProcessing/cost/<startTime>/cost.dat) is written by lubFoam itself.
  *
  * With the elasticWall model (constant/models.yaml) a table is always written, every
@@ -268,6 +269,11 @@ static void wall_pressure(fo *o, lubfoam_run *r)
         if (P->kind[i] != LUB_WALL || P->patch[i] != o->patch) continue;
         double x = P->x[0][i];
         if (x < o->from || x >= o->to) continue;
+        if (r->opt) { /* multi-resolution: each x on the level that owns it */
+            lub_level_where w;
+            lub_levels_locate(&r->opt->L, x, &w);
+            if (w.owner != P->level[i]) continue;
+        }
         int b = (int)((x - o->from) / o->bin);
         if (b >= o->nbins) b = o->nbins - 1;
         o->sum[b] += P->p[i];

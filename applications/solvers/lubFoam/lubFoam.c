@@ -152,6 +152,22 @@ static void print_header(const lubfoam_run *r)
                     w->e.patch_name, w->nw, w->nd, w->e.E, w->e.load, w->e.ramp_time, w->e.b,
                     w->e.p_hertz, w->e.average_steps, w->e.relaxation, w->e.relaxation * w->e.h0,
                     w->e.clamp, w->h0, w->samples);
+        if (w->nlevels > 1) {
+            /* the segments of the deformation and the load: each point of x on one level */
+            char lv[512];
+            size_t len = 0;
+            for (int k = 0; k < w->nlevels && len < sizeof lv; k++) {
+                int owned = 0;
+                for (int s = 0; s < w->ns; s++) owned += w->src_level[s] == k;
+                len += (size_t)snprintf(lv + len, sizeof lv - len,
+                                        "%slevel %d: %d wall, %d dummy particles, %d of them "
+                                        "pressure segments",
+                                        k ? "; " : "", k, w->lv[k].nw, w->lv[k].nd, owned);
+            }
+            lub_message("elasticWall: %s (the wall pressure where the level owns x; the "
+                        "deformation at every wall particle)",
+                        lv);
+        }
     }
 }
 
@@ -204,10 +220,10 @@ static void log_line(const lubfoam_run *r, long steps_done, double wall0, double
         if (o->L.mass_correction)
             snprintf(corr, sizeof corr, " (correction %+.3g m/s)", o->st.correction);
         lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g %s  mass %+.3f%%%s  "
-                    "(p it per step, all levels: %.1f)  ETA %s",
+                    "(p it per step, all levels: %.1f)  ETA %s%s",
                     r->t, 100 * frac, r->step, r->dt, lub_opt_courant_per_dt(o, NULL) * r->dt, lv,
                     r->mass0 > 0 ? 100 * (mc.mass / r->mass0 - 1) : 0.0, corr,
-                    steps_done ? pit_sum / (double)steps_done : 0.0, eta);
+                    steps_done ? pit_sum / (double)steps_done : 0.0, eta, ew);
         return;
     }
     lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g p %3d it %8.2e (mean %.1f)  "
@@ -331,6 +347,8 @@ int main(int argc, char **argv)
          * back after every step for the function objects and the time folders */
         r.opt = lub_malloc(sizeof *r.opt);
         lub_opt_init(r.opt, &levels, &r.P, &cfg, &geo, 0.5);
+        lubfoam_read_elastic(&r, &geo);
+        if (r.has_elastic) lub_opt_moving_wall(r.opt, &geo, r.elastic.patch);
         lub_particles_reserve(&r.P, lub_opt_capacity(r.opt));
         lub_opt_merge(r.opt, &r.P);
         lub_opt_mass m0;
@@ -382,7 +400,7 @@ int main(int argc, char **argv)
         char msg[1024];
         lub_step_status s = LUB_STEP_OK;
         if (r.has_elastic) {
-            s = lub_mps_elastic_before(&r.elastic, &r.mps, r.t, r.dt, msg, sizeof msg);
+            s = lub_mps_elastic_before(&r.elastic, r.t, r.dt, msg, sizeof msg);
             if (s != LUB_STEP_OK) {
                 /* nothing has moved: the current state is good, keep it (unless it is the
                  * start folder or was just written) */
@@ -419,7 +437,7 @@ int main(int argc, char **argv)
             r.step++;
             steps++;
         }
-        if (r.has_elastic) lub_mps_elastic_after(&r.elastic, &r.mps, r.t);
+        if (r.has_elastic) lub_mps_elastic_after(&r.elastic, r.t);
         double co, umax;
         if (r.opt) {
             lub_timer_start(run_timers(&r), LUB_T_OTHER);

@@ -43,8 +43,9 @@ static inline const lub_mps *lubfoam_mps0(const lubfoam_run *r)
 
 /* Start time folder per controlDict (startFrom), reading particles and uniform/state.yaml. */
 void lubfoam_read_start(lubfoam_run *r);
-/* The elasticWall model of constant/models.yaml, if any (after lub_mps_init): its restart
- * state from the start folder's uniform/state.yaml, the ramp checked against endTime. */
+/* The elasticWall model of constant/models.yaml, if any (after lub_mps_init, or lub_opt_init:
+ * then on every level): its restart state from the start folder's uniform/state.yaml, the
+ * ramp checked against endTime. */
 void lubfoam_read_elastic(lubfoam_run *r, const lub_geometry *geo);
 /* Write the current state as a time folder (atomic), update particles.xdmf, purge. */
 void lubfoam_write(lubfoam_run *r);

@@ -76,8 +76,16 @@ void lubfoam_read_elastic(lubfoam_run *r, const lub_geometry *geo)
     lub_case_pathf(&r->cs, state, "%s/uniform/state.yaml", r->start_name);
     int endtime = r->ctl.stop_at == LUB_STOP_ENDTIME;
     snprintf(what, sizeof what, "endTime %g of system/controlDict.yaml", r->ctl.end_time);
-    r->has_elastic = lub_mps_elastic_init(&r->elastic, &r->mps, geo, models, state,
-                                          endtime ? r->ctl.end_time : 0.0, what);
+    const double end = endtime ? r->ctl.end_time : 0.0;
+    if (r->opt) {
+        /* every level's part of the wall (mps/elastic_wall.h, Multi-resolution) */
+        lub_mps *m[LUB_MAX_LEVELS];
+        for (int k = 0; k < r->opt->nlevels; k++) m[k] = &r->opt->m[k];
+        r->has_elastic = lub_mps_elastic_init_levels(&r->elastic, m, r->opt->nlevels, &r->opt->L,
+                                                     geo, models, state, end, what);
+    } else {
+        r->has_elastic = lub_mps_elastic_init(&r->elastic, &r->mps, geo, models, state, end, what);
+    }
 }
 
 static void write_state(const lubfoam_run *r, const char *dir)

@@ -910,14 +910,16 @@ static void run_totals(job *j)
                             "%sthe load on a patch (the integral of p dx along it) is 2-D only; "
                             "%s is %d-D",
                             j->s->patch_node ? "" : "totals -patch: ", j->file, dim);
-            if (lub_wall_integral(&j->P, patch, j->P.p, &row[NFIX]) != 0)
+            /* multi-resolution: each x on the level that owns it (post/wallshape.h) */
+            const lub_geometry *g = ctx_geometry(j->x, NULL);
+            if (lub_wall_integral(&j->P, patch, g, j->P.p, &row[NFIX]) != 0)
                 probe_error(j->s->patch_node,
                             "%spatch '%s' is not a curve y(x) in %s (two wall particles share "
                             "an x), so its load (the integral of p dx) is not defined",
                             j->s->patch_node ? "" : "-patch: ", j->s->patch, j->file);
             const double *pm = lub_particles_find_extra(&j->P, LUB_ELASTIC_FIELD_MEAN);
             row[NFIX + 1] = 0.0;
-            if (mean && pm) lub_wall_integral(&j->P, patch, pm, &row[NFIX + 1]);
+            if (mean && pm) lub_wall_integral(&j->P, patch, g, pm, &row[NFIX + 1]);
         }
         if (L) {
             if (it == 0 && !have_state) {
