@@ -418,6 +418,35 @@ void lub_levels_locate(const lub_levels *L, double x, lub_level_where *w)
         }
 }
 
+/* Length of [a, b] inside [lo, hi], with the images of [a, b] one period either side when
+ * x is periodic. */
+static double covered(const lub_levels *L, double a, double b, double lo, double hi)
+{
+    double len = 0;
+    const double period = L->xmax - L->xmin;
+    for (int s = L->periodic ? -1 : 0; s <= (L->periodic ? 1 : 0); s++) {
+        const double l = fmin(b + s * period, hi) - fmax(a + s * period, lo);
+        if (l > 0) len += l;
+    }
+    return len;
+}
+
+double lub_levels_owned_fraction(const lub_levels *L, int k, double x)
+{
+    if (L->periodic) {
+        const double period = L->xmax - L->xmin;
+        x = L->xmin + fmod(x - L->xmin, period);
+        if (x < L->xmin) x += period;
+    }
+    const double l0 = L->level[k].l0, a = x - 0.5 * l0, b = x + 0.5 * l0;
+    const double in_k =
+        k == L->nlevels - 1 ? l0 : covered(L, a, b, L->level[k].region[0], L->level[k].region[1]);
+    const double in_finer =
+        k == 0 ? 0 : covered(L, a, b, L->level[k - 1].region[0], L->level[k - 1].region[1]);
+    const double f = (in_k - in_finer) / l0;
+    return f < 0 ? 0 : f > 1 ? 1 : f;
+}
+
 void lub_levels_describe(const lub_levels *L, char *buf, size_t size)
 {
     size_t len = 0;

@@ -147,6 +147,17 @@ typedef struct {
  * holes (a level exists on the edge of its hole). */
 void lub_levels_locate(const lub_levels *L, double x, lub_level_where *w);
 
+/* The part of a level-k particle's cell, the interval [x - l0_k/2, x + l0_k/2] of x it
+ * represents, that lies in the part of x level k owns (particleGen's ownership: region k
+ * minus the finer level's region; the last level owns the rest of the domain, its ends
+ * included), as a fraction in [0, 1].  The mass of T-27 counts every point of space on one
+ * level: each fluid particle with rho l0^d times this fraction.  Counting the particles
+ * whose centre is owned instead would make M jump by a whole column of particles whenever
+ * one crosses a boundary (1-2% of a short film's mass); with the fraction a column crossing
+ * a boundary moves M continuously, and a fine and a coarse particle straddling it share the
+ * space between them. */
+double lub_levels_owned_fraction(const lub_levels *L, int k, double x);
+
 /* Overlap length of the boundary between levels k and k + 1 [m]. */
 double lub_levels_overlap(const lub_levels *L, int k);
 

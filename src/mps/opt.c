@@ -1056,17 +1056,20 @@ void lub_opt_mass_count(const lub_opt *o, lub_opt_mass *out)
     for (int k = 0; k < o->nlevels; k++) {
         const lub_particles *P = &o->P[k];
         size_t nf = 0, no = 0;
-#pragma omp parallel for schedule(static) reduction(+ : nf, no)
+        double frac = 0;
+        /* serial: the sum of the fractions in one order, whatever the number of threads
+         * (the mass correction acts on it; a few ns per particle) */
         for (size_t i = 0; i < P->n; i++) {
             if (P->kind[i] != LUB_FLUID) continue;
             nf++;
             lub_level_where w;
             lub_levels_locate(&o->L, P->x[0][i], &w);
             no += w.owner == k;
+            frac += lub_levels_owned_fraction(&o->L, k, P->x[0][i]);
         }
         out->fluid[k] = nf;
         out->owned[k] = no;
-        out->mass += o->m[k].c.rho * pow(o->m[k].l0, o->dim) * (double)no;
+        out->mass += o->m[k].c.rho * pow(o->m[k].l0, o->dim) * frac;
     }
 }
 

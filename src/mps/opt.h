@@ -98,8 +98,9 @@
  * Ids.  Generated particles take ids from next_id on (set-up: one past the largest id of the
  * particles; lubFoam keeps it in uniform/state.yaml, so that a restart continues it).
  *
- * Mass (T-27): M = rho sum over the fluid particles whose x the particle's level owns of
- * l0_level^d (per unit depth in 2-D): each point of space counted on one level.
+ * Mass (T-27): M = rho sum over the fluid particles of l0_level^d f (per unit depth in 2-D),
+ * f the part of the particle's cell that lies where its level owns x
+ * (lub_levels_owned_fraction): each point of space counted on one level.
  */
 #ifndef LUB_MPS_OPT_H
 #define LUB_MPS_OPT_H
@@ -115,8 +116,9 @@
 /* The fluid mass per level (T-27). */
 typedef struct {
     size_t fluid[LUB_MAX_LEVELS]; /* fluid particles of each level */
-    size_t owned[LUB_MAX_LEVELS]; /* of them, those in the part of x their level owns */
-    double mass;                  /* rho sum_k owned_k l0_k^d [kg, or kg/m in 2-D] */
+    size_t owned[LUB_MAX_LEVELS]; /* of them, those whose x their level owns */
+    double mass; /* rho sum l0_k^d f over the fluid particles (f: owned fraction of the cell)
+                    [kg, or kg/m in 2-D] */
 } lub_opt_mass;
 
 /* What the coupling did in the last step. */

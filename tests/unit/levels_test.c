@@ -531,6 +531,43 @@ static void test_gap(void)
     lub_geometry_free(&g);
 }
 
+/* The owned part of a particle's cell (T-27, lub_levels_owned_fraction), on the thesis'
+ * wedge levels (fine 5 um owns [-3.6, 3.0] mm, coarse 40 um the rest of the 20 mm period):
+ * cells wholly inside or outside, cells straddling a1 and a2 (by hand), and the sums over a
+ * lattice of each level covering the whole period at any offset: the owned lengths over l0,
+ * 1320 fine and 335 coarse cells, whatever the lattice's phase (the space counted once). */
+static void test_owned_fraction(void)
+{
+    lub_geometry g;
+    read_geometry(&g, wedge_geo);
+    lub_levels L;
+    read_levels(&L, wedge_models, &g);
+    const double lf = 5e-6, lc = 4e-5, a1 = -0.0036, a2 = 0.003;
+    CHECK_NEAR(lub_levels_owned_fraction(&L, 0, 0.0), 1.0, 0);
+    CHECK_NEAR(lub_levels_owned_fraction(&L, 1, 0.0), 0.0, 0);
+    CHECK_NEAR(lub_levels_owned_fraction(&L, 0, -0.005), 0.0, 0);
+    CHECK_NEAR(lub_levels_owned_fraction(&L, 1, -0.005), 1.0, 0);
+    /* straddling: a fine cell centred 1 um inside a1 has 3.5 of its 5 um inside; a coarse
+     * cell centred 10 um outside a2 has 30 of its 40 um outside; across the periodic seam a
+     * coarse cell is wholly owned */
+    CHECK_NEAR(lub_levels_owned_fraction(&L, 0, a1 + 1e-6), 3.5 / 5, 1e-9);
+    CHECK_NEAR(lub_levels_owned_fraction(&L, 1, a1 + 1e-6), (lc / 2 - 1e-6) / lc, 1e-9);
+    CHECK_NEAR(lub_levels_owned_fraction(&L, 1, a2 + 1e-5), 30.0 / 40, 1e-9);
+    CHECK_NEAR(lub_levels_owned_fraction(&L, 1, 0.01), 1.0, 1e-12);
+    CHECK_NEAR(lub_levels_owned_fraction(&L, 1, -0.01 + 1e-6), 1.0, 1e-12);
+    for (int ph = 0; ph < 4; ph++) {
+        const double phase = 0.3 * ph; /* lattice offset in l0 */
+        double s0 = 0, s1 = 0;
+        for (int i = 0; i < 4000; i++)
+            s0 += lub_levels_owned_fraction(&L, 0, -0.01 + (i + phase) * lf);
+        for (int i = 0; i < 500; i++)
+            s1 += lub_levels_owned_fraction(&L, 1, -0.01 + (i + phase) * lc);
+        CHECK_NEAR(s0, (a2 - a1) / lf, 1e-6);
+        CHECK_NEAR(s1, (0.02 - (a2 - a1)) / lc, 1e-6);
+    }
+    lub_geometry_free(&g);
+}
+
 int main(void)
 {
     RUN(test_wedge_round_trip);
@@ -541,6 +578,7 @@ int main(void)
     RUN(test_bad_input);
     RUN(test_read_case);
     RUN(test_gap);
+    RUN(test_owned_fraction);
     unlink(geo_path);
     return test_summary();
 }

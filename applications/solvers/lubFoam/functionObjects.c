@@ -8,9 +8,10 @@
  *                       timeStart: 0.024, timeEnd: 0.030 }     # averaging window
  *
  * totals.dat:  # t mass momentumX momentumY momentumZ kineticEnergy fluidParticles
- *              (per unit depth in 2-D: particle mass rho l0^d; multi-resolution: over the
- *              fluid particles in the part of x their level owns, each point of space on one
- *              level (T-27), with the mass rho l0^d of its level)
+ *              (per unit depth in 2-D: particle mass rho l0^d; multi-resolution: each point
+ *              of space on one level (T-27), every fluid particle with the mass rho l0^d of
+ *              its level times the owned part of its cell, lub_levels_owned_fraction;
+ *              fluidParticles: those whose x their level owns)
  * p.dat:       # x p n   wall pressure of the patch averaged over the window and the bin
  *              (n: samples; multi-resolution: the wall particles in the part of x their
  *              level owns, as the elasticWall load); rewritten at every write time and at
@@ -242,14 +243,17 @@ static void totals(fo *o, lubfoam_run *r)
         if (P->kind[i] != LUB_FLUID) continue;
         if (r->opt) {
             /* multi-resolution: each point of space counted on the level that owns it
-             * (T-27), with the particle mass of that level */
+             * (T-27): the particle mass of its level times the owned part of its cell;
+             * the count is of the particles whose x their level owns */
             const int k = P->level[i];
             lub_level_where w;
             lub_levels_locate(&r->opt->L, P->x[0][i], &w);
-            if (w.owner != k) continue;
-            mp = r->opt->m[k].c.rho * pow(r->opt->m[k].l0, P->dim);
+            mp = r->opt->m[k].c.rho * pow(r->opt->m[k].l0, P->dim) *
+                 lub_levels_owned_fraction(&r->opt->L, k, P->x[0][i]);
+            if (w.owner == k) nf++;
+        } else {
+            nf++;
         }
-        nf++;
         mass += mp;
         for (int d = 0; d < P->dim; d++) {
             mom[d] += mp * P->u[d][i];

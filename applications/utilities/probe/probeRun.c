@@ -445,6 +445,22 @@ static void run_wall_binned(job *j)
             lub_accum_init(&acc, bins.nbins, j->f.n);
         }
         job_arrays(j);
+        /* multi-resolution: the wall particles of the level that owns their x only (each x
+         * once, as the wallPressure function object and the elasticWall load): the others
+         * get no coordinate */
+        const lub_levels *L = j->P.nlevels > 1 ? ctx_levels(j->x, &j->P) : NULL;
+        if (L) {
+            if (!w) {
+                coord = lub_realloc(coord, (j->P.n ? j->P.n : 1) * sizeof *coord);
+                memcpy(coord, j->P.x[0], j->P.n * sizeof *coord);
+            }
+            for (size_t i = 0; i < j->P.n; i++) {
+                if (j->P.kind[i] != LUB_WALL) continue;
+                lub_level_where lw;
+                lub_levels_locate(L, j->P.x[0][i], &lw);
+                if (lw.owner != j->P.level[i]) coord[i] = NAN;
+            }
+        }
         if (lub_sample_bins(&acc, &bins, &j->P, LUB_WALL, patch, coord, j->vals) == 0)
             lub_warning("time %s: no wall particle of patch '%s' in [%g, %g]", j->times[it].name,
                         j->s->patch, bins.from, bins.to);
@@ -831,12 +847,13 @@ static void run_shape(job *j)
 
 /* ---- totals: one row per time --------------------------------------------------------- */
 
-/* Multi-resolution totals (T-27): each fluid particle counted where its level owns x, with
- * the particle mass of its level, as lubFoam's totals function object counts them. */
+/* Multi-resolution totals (T-27): each fluid particle with the particle mass of its level
+ * times the owned part of its cell (lub_levels_owned_fraction), as lubFoam's totals
+ * function object counts them; owned[k]: the particles whose x their level owns. */
 static void owned_totals(const lub_particles *P, const lub_levels *L, double rho, lub_totals *t,
                          size_t owned[LUB_MAX_LEVELS])
 {
-    double su[LUB_MAX_LEVELS][3] = {{0}}, su2[LUB_MAX_LEVELS] = {0};
+    double su[LUB_MAX_LEVELS][3] = {{0}}, su2[LUB_MAX_LEVELS] = {0}, sf[LUB_MAX_LEVELS] = {0};
     memset(t, 0, sizeof *t);
     for (int k = 0; k < LUB_MAX_LEVELS; k++) owned[k] = 0;
     for (size_t i = 0; i < P->n; i++) {
@@ -844,17 +861,18 @@ static void owned_totals(const lub_particles *P, const lub_levels *L, double rho
         const int k = P->level[i];
         lub_level_where w;
         lub_levels_locate(L, P->x[0][i], &w);
-        if (w.owner != k) continue;
-        owned[k]++;
+        if (w.owner == k) owned[k]++;
+        const double f = lub_levels_owned_fraction(L, k, P->x[0][i]);
+        sf[k] += f;
         for (int d = 0; d < P->dim; d++) {
-            su[k][d] += P->u[d][i];
-            su2[k] += P->u[d][i] * P->u[d][i];
+            su[k][d] += f * P->u[d][i];
+            su2[k] += f * P->u[d][i] * P->u[d][i];
         }
     }
     for (int k = 0; k < L->nlevels; k++) {
         const double m = rho * pow(L->level[k].l0, P->dim);
         t->nfluid += owned[k];
-        t->mass += m * (double)owned[k];
+        t->mass += m * sf[k];
         for (int d = 0; d < 3; d++) t->momentum[d] += m * su[k][d];
         t->kinetic += 0.5 * m * su2[k];
     }
