@@ -7,7 +7,8 @@
  *                       from: -0.0045, to: 0.0045,             # x range (default: domain)
  *                       timeStart: 0.024, timeEnd: 0.030 }     # averaging window
  *
- * totals.dat:  # t mass momentumX momentumY momentumZ kineticEnergy fluidParticles
+ * totals.dat:  # t[s] mass[kg/m] momentumX[kg/s] momentumY[kg/s] momentumZ[kg/s]
+ *              kineticEnergy[J/m] fluidParticles (3-D: [kg], [kg*m/s], [J])
  *              (per unit depth in 2-D: particle mass rho l0^d; multi-resolution: each point
  *              of space on one level (T-27), every fluid particle with the mass rho l0^d of
  *              its level times the owned part of its cell, lub_levels_owned_fraction;
@@ -195,8 +196,12 @@ lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
             lub_postproc_path(&r->cs, name, r->start_name, "totals.dat", path);
             o->fp = fopen(path, "w");
             if (!o->fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
-            lub_table_write_header(o->fp, "t mass momentumX momentumY momentumZ kineticEnergy "
-                                          "fluidParticles");
+            /* units as probe totals writes them: per unit depth in 2-D */
+            lub_table_write_header(
+                o->fp, r->P.dim == 2 ? "t[s] mass[kg/m] momentumX[kg/s] momentumY[kg/s] "
+                                       "momentumZ[kg/s] kineticEnergy[J/m] fluidParticles"
+                                     : "t[s] mass[kg] momentumX[kg*m/s] momentumY[kg*m/s] "
+                                       "momentumZ[kg*m/s] kineticEnergy[J] fluidParticles");
         } else {
             const char *patch = lub_dict_str(d, "patch");
             o->patch = lub_particles_find_patch(&r->P, patch);
