@@ -479,6 +479,23 @@ static inline size_t cell_index(const lub_neighbours *nb, int a, int b, int e)
     return (size_t)a + (size_t)nb->nc[0] * ((size_t)b + (size_t)nb->nc[1] * (size_t)e);
 }
 
+/* Every particle of a cell list in the cells around x, in cell order, into out (so every
+ * particle within the list's radius of x); returns the count. */
+static size_t cells_collect(const lub_neighbours *nb, int dim, const double x[3], size_t *out)
+{
+    int cells[3][3], nc[3];
+    cells_around(nb, dim, x, cells, nc);
+    size_t n = 0;
+    for (int a = 0; a < nc[0]; a++)
+        for (int b = 0; b < nc[1]; b++)
+            for (int e = 0; e < nc[2]; e++) {
+                const size_t cell = cell_index(nb, cells[0][a], cells[1][b], cells[2][e]);
+                for (size_t q = nb->cell_start[cell]; q < nb->cell_start[cell + 1]; q++)
+                    out[n++] = nb->perm[q];
+            }
+    return n;
+}
+
 /* A source of interpolated values: a level's particles now, or (sub-stepping) the coarser
  * level as it was at the start of its step, state K of T-20..T-22. */
 typedef struct {
@@ -510,21 +527,14 @@ typedef struct {
 static size_t gather(const lub_opt *o, const source *S, const double x[3], int skip_fixed,
                      size_t *out)
 {
-    const lub_neighbours *nb = S->cells;
     const lub_particles *P = S->P;
     const uint8_t *fix = S->fixed;
-    int cells[3][3], nc[3];
-    cells_around(nb, o->dim, x, cells, nc);
+    const size_t all = cells_collect(S->cells, o->dim, x, out);
     size_t n = 0;
-    for (int a = 0; a < nc[0]; a++)
-        for (int b = 0; b < nc[1]; b++)
-            for (int e = 0; e < nc[2]; e++) {
-                const size_t cell = cell_index(nb, cells[0][a], cells[1][b], cells[2][e]);
-                for (size_t q = nb->cell_start[cell]; q < nb->cell_start[cell + 1]; q++) {
-                    const size_t j = nb->perm[q];
-                    if (P->kind[j] != LUB_DUMMY && !(skip_fixed && fix[j])) out[n++] = j;
-                }
-            }
+    for (size_t q = 0; q < all; q++) {
+        const size_t j = out[q];
+        if (P->kind[j] != LUB_DUMMY && !(skip_fixed && fix[j])) out[n++] = j;
+    }
     return n;
 }
 
@@ -714,6 +724,18 @@ static size_t delete_buried(lub_opt *o, int k, double dt)
 
 /* Whether a particle of level A is to be created at generation cell c (see lub_opt_transfer);
  * val receives its u (3), p and grad p (3) interpolated from the other level (b). */
+/* Squared distance (minimum image) from particle j of P to c. */
+static double dist2(const lub_particles *P, int dim, size_t j, const double c[3],
+                    const double period[3])
+{
+    double r2 = 0;
+    for (int d = 0; d < dim; d++) {
+        const double v = lub_min_image(P->x[d][j] - c[d], period[d]);
+        r2 += v * v;
+    }
+    return r2;
+}
+
 static int decide(lub_opt *o, int A, const double c[3], double dt, const blend *bl, size_t *cand,
                   double val[7])
 {
@@ -721,61 +743,40 @@ static int decide(lub_opt *o, int A, const double c[3], double dt, const blend *
     const double l0 = o->m[A].l0;
     double period[3] = {0, 0, 0};
     for (int d = 0; d < dim; d++) period[d] = o->lsq[A].period[d];
-    int cells[3][3], nc[3];
 
     /* nearest particle of A: leave the cell alone while one is within half a cell; and the
      * nearest of its wall and dummy particles: a dummy of a wall a model moves puts the cell
      * behind that wall (lub_opt_moving_wall) */
-    const lub_neighbours *na = &o->src[A];
     const lub_particles *PA = &o->P[A];
     double d2min = INFINITY, d2wall = INFINITY;
     size_t jwall = 0;
-    cells_around(na, dim, c, cells, nc);
-    for (int a = 0; a < nc[0]; a++)
-        for (int b = 0; b < nc[1]; b++)
-            for (int e = 0; e < nc[2]; e++) {
-                const size_t cell = cell_index(na, cells[0][a], cells[1][b], cells[2][e]);
-                for (size_t q = na->cell_start[cell]; q < na->cell_start[cell + 1]; q++) {
-                    const size_t j = na->perm[q];
-                    double r2 = 0;
-                    for (int d = 0; d < dim; d++) {
-                        const double v = lub_min_image(PA->x[d][j] - c[d], period[d]);
-                        r2 += v * v;
-                    }
-                    if (r2 < d2min) d2min = r2;
-                    if (PA->kind[j] != LUB_FLUID && r2 < d2wall) d2wall = r2, jwall = j;
-                }
-            }
+    size_t n = cells_collect(&o->src[A], dim, c, cand);
+    for (size_t q = 0; q < n; q++) {
+        const size_t j = cand[q];
+        const double r2 = dist2(PA, dim, j, c, period);
+        if (r2 < d2min) d2min = r2;
+        if (PA->kind[j] != LUB_FLUID && r2 < d2wall) d2wall = r2, jwall = j;
+    }
     if (d2min < 0.25 * l0 * l0) return 0;
     if (d2wall < INFINITY && PA->kind[jwall] == LUB_DUMMY && o->moved[PA->patch[jwall]]) return 0;
 
     /* the other level's fluid fills the cell: PND of its fluid against the room its walls
      * leave (T-4 sums at c), in the state nearer in time */
     const source *S = bl->old && bl->w >= 0.5 ? bl->old : bl->now;
-    const lub_neighbours *nb = S->cells;
     const lub_particles *PB = S->P;
     const double re = S->re, n0 = S->n0;
     double nf = 0, nw = 0;
-    cells_around(nb, dim, c, cells, nc);
-    for (int a = 0; a < nc[0]; a++)
-        for (int b = 0; b < nc[1]; b++)
-            for (int e = 0; e < nc[2]; e++) {
-                const size_t cell = cell_index(nb, cells[0][a], cells[1][b], cells[2][e]);
-                for (size_t q = nb->cell_start[cell]; q < nb->cell_start[cell + 1]; q++) {
-                    const size_t j = nb->perm[q];
-                    double r2 = 0;
-                    for (int d = 0; d < dim; d++) {
-                        const double v = lub_min_image(PB->x[d][j] - c[d], period[d]);
-                        r2 += v * v;
-                    }
-                    if (!(r2 < re * re)) continue;
-                    const double w = lub_mps_weight(sqrt(r2), re);
-                    if (PB->kind[j] == LUB_FLUID)
-                        nf += w;
-                    else
-                        nw += w;
-                }
-            }
+    n = cells_collect(S->cells, dim, c, cand);
+    for (size_t q = 0; q < n; q++) {
+        const size_t j = cand[q];
+        const double r2 = dist2(PB, dim, j, c, period);
+        if (!(r2 < re * re)) continue;
+        const double w = lub_mps_weight(sqrt(r2), re);
+        if (PB->kind[j] == LUB_FLUID)
+            nf += w;
+        else
+            nw += w;
+    }
     const double room = n0 - nw;
     if (!(room > 0.1 * n0) || !(nf > S->fill * room)) return 0;
 

@@ -23,6 +23,7 @@
 #include <unistd.h>
 
 #include "geometry/discretise.h"
+#include "flow.h" /* generate() */
 #include "geometry/geometry.h"
 #include "mps/mps.h"
 #include "test.h"
@@ -30,18 +31,6 @@
 #ifndef M_PI
 #define M_PI 3.14159265358979323846
 #endif
-
-/* Generate particles from particleGenDict text. */
-static void generate(const char *text, lub_particles *P, lub_geometry *g)
-{
-    char path[] = "/tmp/lubescapeXXXXXX";
-    int fd = mkstemp(path);
-    if (fd < 0 || write(fd, text, strlen(text)) != (ssize_t)strlen(text)) abort();
-    close(fd);
-    lub_geometry_read(g, path);
-    unlink(path);
-    lub_geometry_discretise(g, P, 0, NULL);
-}
 
 typedef struct {
     lub_particles P;
