@@ -14,10 +14,10 @@
 
 /* ---- particles: split, fill, merge ------------------------------------------------------ */
 
-/* Append particle i of src to dst (capacity reserved; extra fields in the same order). */
-static void copy_particle(lub_particles *dst, const lub_particles *src, size_t i)
+/* Particle i of src into slot k of dst (room reserved; extra fields in the same order; dst
+ * may be src, with k <= i). */
+static void put_particle(lub_particles *dst, size_t k, const lub_particles *src, size_t i)
 {
-    const size_t k = dst->n++;
     for (int d = 0; d < 3; d++) {
         dst->x[d][k] = src->x[d][i];
         dst->u[d][k] = src->u[d][i];
@@ -28,6 +28,12 @@ static void copy_particle(lub_particles *dst, const lub_particles *src, size_t i
     dst->level[k] = src->level[i];
     dst->id[k] = src->id[i];
     for (int e = 0; e < src->nextra; e++) dst->extra[e].v[k] = src->extra[e].v[i];
+}
+
+/* Append particle i of src to dst. */
+static void copy_particle(lub_particles *dst, const lub_particles *src, size_t i)
+{
+    put_particle(dst, dst->n++, src, i);
 }
 
 /* The margins of level k: the parts of its extended region it does not own, as closed
@@ -669,16 +675,7 @@ static size_t compact(lub_opt *o, int k, const uint8_t *drop)
     for (size_t i = 0; i < P->n; i++) {
         if (drop[i]) continue;
         if (w != i) {
-            for (int d = 0; d < 3; d++) {
-                P->x[d][w] = P->x[d][i];
-                P->u[d][w] = P->u[d][i];
-            }
-            P->p[w] = P->p[i];
-            P->kind[w] = P->kind[i];
-            P->patch[w] = P->patch[i];
-            P->level[w] = P->level[i];
-            P->id[w] = P->id[i];
-            for (int e = 0; e < P->nextra; e++) P->extra[e].v[w] = P->extra[e].v[i];
+            put_particle(P, w, P, i);
             fix[w] = fix[i];
         }
         w++;
