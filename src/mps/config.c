@@ -44,7 +44,7 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->predictor = 0.1;
     c->beta = 0.97;
     c->asymmetry = 0.2;
-    c->skin = 0.2;
+    c->skin = 0.0;
     c->lsmps_det_min = LUB_MPS_LSMPS_DET_MIN;
     c->reorder_interval = 50;
     c->mirror_dummies = 1;
@@ -96,7 +96,7 @@ static void read_schemes(lub_mps_config *c, const char *path)
     lub_node *fs = lub_dict_map_or(r, "freeSurface");
     c->beta = lub_dict_real_or(fs, "beta", 0.97, (lub_range){0.0, 1.0, 1, 1});
     c->asymmetry = lub_dict_real_or(fs, "asymmetry", 0.2, LUB_BETWEEN(0.0, 10.0));
-    c->skin = lub_dict_real_or(r, "neighbourSkin", 0.2, LUB_BETWEEN(0.0, 1.0));
+    c->skin = lub_dict_real_or(r, "neighbourSkin", 0.0, LUB_BETWEEN(0.0, 1.0));
     c->lsmps_det_min =
         lub_dict_real_or(r, "lsmpsDetMin", LUB_MPS_LSMPS_DET_MIN, (lub_range){0.0, 1.0, 1, 1});
     c->reorder_interval = (int)lub_dict_int_or(r, "reorderInterval", 50, 0, 1000000);

@@ -2,7 +2,7 @@
  *
  * The step follows the thesis (Figure 1):
  *
- *     1. neighbour lists at r^k (cell-linked list, kept with a skin)
+ *     1. neighbour lists at r^k (cell-linked list; kept while particles move < skin re / 2)
  *     2. viscosity and body force -> u*           explicit (T-7) or Crank-Nicolson (T-31)
  *        (pressure predictor: with the force -G/rho of the running mean G of the pressure
  *        gradient, which is then added back: u* += dt G / rho)
@@ -67,7 +67,7 @@ typedef struct {
                                particle is on the surface (0: PND test only) */
     double skin;            /* neighbour search radius re (1 + skin) */
     double lsmps_det_min;   /* LSMPS fallback threshold */
-    int reorder_interval;   /* steps between cell-order sorts (0: never) */
+    int reorder_interval;   /* steps between lattice-row sorts (0: never) */
     int mirror_dummies;     /* dummies take the no-slip ghost velocity 2 U - u_i (viscosity) */
 
     /* system/solution.yaml */

@@ -69,6 +69,7 @@ void lub_neighbours_set_box(lub_neighbours *nb, const double lo[3], const double
                   "supported: is the box much larger than the particles?",
                   ncells, nb->rs);
     nb->ncells = (size_t)ncells;
+    if (nb->order_h > 0) lub_neighbours_set_order(nb, nb->order_h);
     if (nb->ncells + 1 > nb->cap_cells) {
         free(nb->cell_start);
         free(nb->cursor);
@@ -89,7 +90,31 @@ void lub_neighbours_free(lub_neighbours *nb)
     free(nb->spos);
     free(nb->cell_start);
     free(nb->cursor);
+    free(nb->order_count);
     memset(nb, 0, sizeof *nb);
+}
+
+void lub_neighbours_set_order(lub_neighbours *nb, double h)
+{
+    if (!(h >= 0) || !isfinite(h))
+        lub_fatal("neighbour search: sort spacing %g, expected a number >= 0", h);
+    nb->order_h = h;
+    if (h == 0) return;
+    size_t most = 1;
+    for (int d = 0; d < 3; d++) {
+        double m = d < nb->dim ? floor((nb->hi[d] - nb->lo[d]) / h) + 1.0 : 1.0;
+        if (m > 1e8)
+            lub_fatal("neighbour search: %.3g rows of spacing %g in %c, more than the 1e8 "
+                      "supported",
+                      m, h, axis_name[d]);
+        nb->order_n[d] = (uint32_t)m;
+        if ((size_t)m > most) most = (size_t)m;
+    }
+    if (most + 1 > nb->cap_order) {
+        free(nb->order_count);
+        nb->cap_order = most + 1;
+        nb->order_count = lub_malloc(nb->cap_order * sizeof *nb->order_count);
+    }
 }
 
 static void reserve_particles(lub_neighbours *nb, size_t n)
@@ -190,6 +215,39 @@ size_t lub_neighbours_bin(lub_neighbours *nb, size_t n, double *const x[3])
         nb->spos[i] = (uint32_t)k;
         for (int d = 0; d < dim; d++) nb->xs[d][k] = xi[d];
     }
+    nb->nescaped = escaped;
+    return escaped;
+}
+
+size_t lub_neighbours_order(lub_neighbours *nb, size_t n, double *const x[3])
+{
+    if (nb->order_h == 0) return lub_neighbours_bin(nb, n, x);
+    reserve_particles(nb, n);
+    const int dim = nb->dim;
+    const double inv = 1.0 / nb->order_h;
+    /* Least significant digit radix sort: a stable counting sort by the x row, then by the y
+     * row (then z).  The keys go into cell[], the passes alternate between spos[] and perm[]. */
+    uint32_t *key = nb->cell, *src = nb->spos, *dst = nb->perm;
+    size_t escaped = 0;
+    for (size_t i = 0; i < n; i++) src[i] = (uint32_t)i;
+    for (int d = 0; d < dim; d++) {
+        const uint32_t rows = nb->order_n[d];
+        for (size_t i = 0; i < n; i++) {
+            double xi[3] = {0, 0, 0};
+            int out = search_position(nb, x, i, xi);
+            if (d == 0) escaped += (size_t)out;
+            double r = floor((xi[d] - nb->lo[d]) * inv);
+            key[i] = r >= 0 && r < rows ? (uint32_t)r : r >= rows ? rows - 1 : 0; /* NaN: 0 */
+        }
+        size_t *count = nb->order_count;
+        memset(count, 0, ((size_t)rows + 1) * sizeof *count);
+        for (size_t k = 0; k < n; k++) count[key[src[k]] + 1]++;
+        for (uint32_t r = 0; r < rows; r++) count[r + 1] += count[r];
+        for (size_t k = 0; k < n; k++) dst[count[key[src[k]]]++] = src[k];
+        uint32_t *t = src;
+        src = dst, dst = t;
+    }
+    if (src != nb->perm) memcpy(nb->perm, src, n * sizeof *src);
     nb->nescaped = escaped;
     return escaped;
 }
@@ -394,16 +452,21 @@ size_t lub_neighbours_update(lub_neighbours *nb, double *const x[3])
     const double lim = 0.5 * (nb->rs - nb->re);
     double L[3];
     for (int d = 0; d < 3; d++) L[d] = d < dim && nb->periodic[d] ? nb->period[d] : 0.0;
+    /* First the displacements since the build (positions then: xs, wrapped; minimum image):
+     * when a rebuild is due the pairs are not worth updating. */
     size_t moved = 0;
 #pragma omp parallel for schedule(static) reduction(+ : moved)
     for (size_t i = 0; i < n; i++) {
-        /* displacement since the build (positions then: xs, wrapped), minimum image */
         double d2 = 0.0;
         for (int d = 0; d < dim; d++) {
             const double v = lub_min_image(x[d][i] - nb->xs[d][nb->spos[i]], L[d]);
             d2 += v * v;
         }
         if (!(d2 <= lim * lim)) moved++;
+    }
+    if (moved) return moved;
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
         if (dim == 2)
             update_particle(nb, x, i, L, 2);
         else

@@ -19,10 +19,12 @@
  * with skin > 0) are stored with w = 0.  |r_ij| is not stored: the sweeps are memory-bound,
  * and the operators that need it form it from r_ij.
  *
- * Cell order for cache locality: after lub_neighbours_bin (or _build), perm[k] is the index
- * of the k-th particle in cell order.  To sort the caller's structure-of-arrays data:
+ * Order for cache locality: after lub_neighbours_bin (or _build), perm[k] is the index of the
+ * k-th particle in cell order; after lub_neighbours_order, in the order set by
+ * lub_neighbours_set_order (rows of l0: better for the pressure solve).  To sort the caller's
+ * structure-of-arrays data:
  *
- *     lub_neighbours_bin(&nb, n, x);
+ *     lub_neighbours_order(&nb, n, x);                   (or lub_neighbours_bin)
  *     lub_reorder(n, nb.perm, scratch, x[0], sizeof(double)); ... for every per-particle array
  *     lub_neighbours_build(&nb, n, x);                   (the lists refer to the new order)
  *
@@ -76,6 +78,12 @@ typedef struct {
     size_t *cell_start; /* [ncells + 1] */
     size_t *cursor;     /* [ncells] */
     size_t cap_n, cap_pairs, cap_cells;
+
+    /* sort order of lub_neighbours_order: rows of spacing order_h (0: cell order) */
+    double order_h;
+    uint32_t order_n[3]; /* rows in each direction */
+    size_t *order_count; /* [max order_n + 1] */
+    size_t cap_order;
 } lub_neighbours;
 
 /* Set up an empty search structure.  skin >= 0 enlarges the search radius for
@@ -92,13 +100,26 @@ void lub_neighbours_free(lub_neighbours *nb);
  * the position components (x[2] unused in 2-D, may be NULL); not modified.  Returns the
  * number of escaped particles. */
 size_t lub_neighbours_bin(lub_neighbours *nb, size_t n, double *const x[3]);
+/* The order lub_neighbours_order sorts the particles into: lattice rows of spacing h (h = l0,
+ * the particle spacing), x fastest, then y, then z, stable in the particle index; h = 0: cell
+ * order (lub_neighbours_bin).  Cells are re (about 3 l0) wide, and within a cell the particles
+ * keep whatever order they had; sorting by rows of l0 instead makes the order of every
+ * neighbourhood the same lexicographic lattice order, and the incomplete-Cholesky
+ * preconditioned pressure solve takes about 25% fewer iterations (the wedge).  Allocates the
+ * counts for the box (call it after init; set_box keeps it). */
+void lub_neighbours_set_order(lub_neighbours *nb, double h);
+/* Fill perm with the order set by lub_neighbours_set_order (perm[k] = index of the k-th
+ * particle).  Uses the internal arrays as scratch: the lists and positions of the last build
+ * are then invalid, so rebuild (lub_neighbours_build) after reordering the particles.  Returns
+ * the number of escaped particles. */
+size_t lub_neighbours_order(lub_neighbours *nb, size_t n, double *const x[3]);
 /* Bin, then build the lists.  Returns the number of escaped particles. */
 size_t lub_neighbours_build(lub_neighbours *nb, size_t n, double *const x[3]);
 /* Recompute dx, r and w of the stored pairs for moved positions x of the same particles in
  * the same order, e.g. the PND at the temporary positions (T-11) without a new search.  The
  * lists still hold every pair closer than re while each particle has moved less than
  * skin re / 2 since the build; returns the number of particles that moved further (0: the
- * lists are complete; otherwise rebuild). */
+ * lists are complete and updated; otherwise they are left as they were: rebuild). */
 size_t lub_neighbours_update(lub_neighbours *nb, double *const x[3]);
 
 /* Minimum image of a coordinate difference v for period L (L = 0: not periodic).  Positions

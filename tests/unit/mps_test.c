@@ -351,6 +351,86 @@ static void test_reorder(void)
     cloud_free(&c);
 }
 
+/* Lattice-row order (lub_neighbours_order): perm is a permutation, sorted by the rows of
+ * spacing h (z, then y, then x; x fastest) as computed here independently, stable in the
+ * particle index among equal rows; periodic positions outside the box count at their image,
+ * escaped ones in the edge rows.  After reordering and rebuilding, the lists are complete. */
+static void check_order(int dim)
+{
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 0.5, 0.3}, h = 0.037;
+    const int per[3] = {1, 0, 1};
+    cloud c;
+    cloud_init(&c, 1200);
+    for (size_t i = 0; i < 1000; i++) {
+        double p[3] = {0, 0, 0};
+        for (int d = 0; d < dim; d++) p[d] = lo[d] + (hi[d] - lo[d]) * rnd();
+        /* a few rows shared by several particles in every direction (stability) */
+        if (i % 7 == 0) p[0] = 0.5 * h + h * floor(27 * rnd());
+        if (i % 50 == 1) p[0] += 2.0 * (hi[0] - lo[0]); /* a periodic image */
+        if (i % 97 == 3) p[1] = hi[1] + 0.3;            /* escaped: the last y row */
+        if (i % 89 == 5) p[1] = lo[1] - 0.2;            /* escaped: the first y row */
+        cloud_add(&c, p[0], p[1], p[2], 0);
+    }
+    const size_t n = c.n;
+    lub_neighbours nb;
+    lub_neighbours_init(&nb, dim, 0.1, 0.0, lo, hi, per);
+    lub_neighbours_set_order(&nb, h);
+    size_t escaped = lub_neighbours_order(&nb, n, c.x);
+    CHECK(escaped == 11 + 12);
+    long *key = malloc(n * sizeof *key);
+    for (size_t i = 0; i < n; i++) {
+        long k = 0;
+        for (int d = dim - 1; d >= 0; d--) {
+            double v = c.x[d][i], L = hi[d] - lo[d];
+            if (per[d]) v -= L * floor((v - lo[d]) / L);
+            long rows = (long)floor(L / h) + 1, r = (long)floor((v - lo[d]) / h);
+            r = r < 0 ? 0 : r >= rows ? rows - 1 : r;
+            k = k * rows + r;
+        }
+        key[i] = k;
+    }
+    char *seen = calloc(n, 1);
+    int isperm = 1, sorted = 1;
+    for (size_t k = 0; k < n; k++) {
+        uint32_t i = nb.perm[k];
+        if (i >= n || seen[i])
+            isperm = 0;
+        else
+            seen[i] = 1;
+        if (k > 0 && isperm) {
+            uint32_t a = nb.perm[k - 1];
+            if (key[i] < key[a] || (key[i] == key[a] && i < a)) sorted = 0;
+        }
+    }
+    CHECK(isperm);
+    CHECK(sorted);
+    void *scratch = malloc(n * 8);
+    void *arrays[3] = {c.x[0], c.x[1], dim == 3 ? c.x[2] : NULL};
+    size_t sizes[3] = {8, 8, 8};
+    lub_reorder_set(n, nb.perm, scratch, 3, arrays, sizes);
+    lub_neighbours_build(&nb, n, c.x);
+    CHECK(compare_brute(&nb, &c, lo, hi, per) == 0);
+    /* h = 0: cell order, as lub_neighbours_bin */
+    lub_neighbours_set_order(&nb, 0.0);
+    lub_neighbours_order(&nb, n, c.x);
+    int cells = 1;
+    for (size_t k = 1; k < n; k++) cells &= nb.cell[nb.perm[k]] >= nb.cell[nb.perm[k - 1]];
+    CHECK(cells);
+    CHECK_FATAL(lub_neighbours_set_order(&nb, -1.0), "sort spacing");
+    free(key), free(seen), free(scratch);
+    lub_neighbours_free(&nb);
+    cloud_free(&c);
+}
+
+static void test_order_2d(void)
+{
+    check_order(2);
+}
+static void test_order_3d(void)
+{
+    check_order(3);
+}
+
 /* n0 and lambda0 of the square lattice at re = 3.1 l0, by hand: the nodes within 3.1 are
  *   (1,0) x4 at 1, (1,1) x4 at sqrt 2, (2,0) x4 at 2, (2,1) x8 at sqrt 5,
  *   (2,2) x4 at sqrt 8 = 2.83, (3,0) x4 at 3;   (3,1) at sqrt 10 = 3.16 is outside. */
@@ -794,8 +874,11 @@ static void test_update(void)
         err = fmax(err, fabs(pnd[i] - s));
     }
     CHECK(err < 1e-12);
+    /* a particle beyond skin re / 2: rebuild; the lists are left as they were */
+    const double dx0 = nb.dx[0][nb.start[5]];
     c.x[0][5] += 0.2 * re;
     CHECK(lub_neighbours_update(&nb, c.x) == 1);
+    CHECK(nb.dx[0][nb.start[5]] == dx0);
     free(pnd);
     lub_neighbours_free(&nb);
     cloud_free(&c);
@@ -837,6 +920,8 @@ int main(void)
     RUN(test_search_bad_input);
     RUN(test_search_escaped);
     RUN(test_reorder);
+    RUN(test_order_2d);
+    RUN(test_order_3d);
     RUN(test_reference_2d);
     RUN(test_reference_3d);
     RUN(test_laplacian_lattice_2d);
