@@ -120,12 +120,17 @@ static void read_solution(lub_mps_config *c, const char *path)
  * line.  Called after lub_dict_finish, so that a misspelt key is reported first. */
 static void check_supported(const lub_levels *L, lub_node *mr, lub_node *root)
 {
-    if (L->nlevels > 2)
-        lub_node_error(mr, "multiResolution: %d levels: this version of lubFoam runs 2 levels",
-                       L->nlevels);
     /* the elastic wall across levels (mps/elastic_wall.h) moves every level's wall each step
-     * from one deformation: every level takes the same steps (T-60) */
+     * from one deformation: every level takes the same steps (T-60); it is tested on two
+     * levels (tests/cases/softEHLOPT) */
     lub_node *ew = lub_dict_find(root, "elasticWall");
+    if (ew && L->nlevels > 2)
+        lub_node_error(ew,
+                       "model 'elasticWall' with 'multiResolution' (%s:%d) runs on 2 levels "
+                       "only, and the case has %d (system/particleGenDict.yaml's levels): the "
+                       "elastic wall across more levels is not supported in this version",
+                       lub_node_file(mr) ? lub_node_file(mr) : "constant/models.yaml",
+                       lub_node_line(mr), L->nlevels);
     int nr = 1;
     for (int k = 0; k < L->nlevels - 1; k++)
         if (L->level[k].nr > nr) nr = L->level[k].nr;

@@ -51,9 +51,19 @@
  * must not meet either (an overlap longer than a level region), and in a non-periodic domain
  * an overlap must not reach past the domain.
  *
+ * Any number of levels from 2 up (LUB_MAX_LEVELS; the thesis uses 2 and proposes 3-4 for
+ * 3-D), e.g. three:
+ *
+ *     levels:                                              # particleGenDict.yaml
+ *       - { l0: 0.001, region: [0.1, 0.136] }              # level 0 owns [0.1, 0.136]
+ *       - { l0: 0.002, region: [0.056, 0.18] }             # level 1 the ring around it
+ *       - { l0: 0.004 }                                    # level 2 the rest
+ *     multiResolution: { Nr: [2, 2] }                      # models.yaml: Nr_0, Nr_1
+ *
  * Sub-stepping (T-19..T-22): level k+1 advances Nr_k steps of level k at once, dt_{k+1} =
- * Nr_k dt_k; with a Courant number fixed on every level Nr equals the l0 ratio (the thesis'
- * wedge), which is the default and must then be an integer.  commonDeltaT (soft EHL, T-60)
+ * Nr_k dt_k (dt_factor of level k: the product of the finer levels' Nr); with a Courant
+ * number fixed on every level Nr equals the l0 ratio (the thesis' wedge), which is the
+ * default and must then be an integer.  commonDeltaT (soft EHL, T-60)
  * gives every level the finest dt.  While level k takes its sub-steps b = 0 .. Nr-1 after the
  * coarser level's step K, the coarser values are interpolated linearly in time
  * (lub_levels_time_weight): T-20 as printed weights the old value by b/Nr, which is 0 at
@@ -62,7 +72,8 @@
  *
  * Mass correction (T-27..T-29; T-61 without cMin): when |M^k - M^0| > threshold M^0, the
  * particles of the overlaps get the x-velocity correction B sgn(M^k - M^0) (sign chosen by the
- * solver to drive the mass back), B = max(min(|M^k - M^0| / (rho A C_relax dt), cMax), cMin).
+ * solver to drive the mass back, per boundary), B = max(min(|M^k - M^0| / (rho A C_relax dt),
+ * cMax), cMin); mps/opt.h.
  *
  * Errors are fatal with file:line of the entry (models.yaml, or particleGenDict.yaml for the
  * regions it owns); the reader asks for every key it knows, so lub_dict_finish() on

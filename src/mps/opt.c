@@ -305,15 +305,17 @@ void lub_opt_init(lub_opt *o, const lub_levels *L, const lub_particles *P, const
     /* each level's step count (the reorder schedule of lub_mps_step) in its own steps: the
      * particle file counts the finest level's */
     for (int k = 0; k < o->nlevels; k++) o->m[k].steps = P->step / L->level[k].dt_factor;
-    o->nr = L->common_dt ? 1 : L->level[0].nr;
-    if (o->nr > 1) {
-        if (o->nlevels != 2) lub_bug("lub_opt_init: sub-stepping with %d levels", o->nlevels);
-        const lub_particles *C = &o->P[1];
-        lub_particles_init(&o->PK, o->dim, C->cap);
-        o->fixK = lub_calloc(C->cap, 1);
-        lub_neighbours_init(&o->srcK, o->dim, o->m[1].re, 0.0, g->dmin, g->dmax, g->periodic);
-        lub_neighbours_bin(&o->srcK, C->cap, o->PK.x);
-    }
+    /* finest steps per step of the coarsest level: the product of the Nr (1: commonDeltaT) */
+    o->nr = L->common_dt ? 1 : (int)L->level[o->nlevels - 1].dt_factor;
+    if (o->nr > 1)
+        for (int k = 1; k < o->nlevels; k++) { /* state K of every coarser level, sized once */
+            lub_opt_saved *K = &o->K[k];
+            const lub_particles *C = &o->P[k];
+            lub_particles_init(&K->P, o->dim, C->cap);
+            K->fixed = lub_calloc(C->cap, 1);
+            lub_neighbours_init(&K->cells, o->dim, o->m[k].re, 0.0, g->dmin, g->dmax, g->periodic);
+            lub_neighbours_bin(&K->cells, C->cap, K->P.x);
+        }
     o->next_id = next;
     o->nthreads = omp_get_max_threads();
     o->cand = lub_malloc((size_t)o->nthreads * o->cap_cand * sizeof *o->cand);
@@ -341,11 +343,12 @@ void lub_opt_free(lub_opt *o)
         free(o->gen_val[k]);
         free(o->drop[k]);
     }
-    if (o->nr > 1) {
-        lub_particles_free(&o->PK);
-        free(o->fixK);
-        lub_neighbours_free(&o->srcK);
-    }
+    if (o->nr > 1)
+        for (int k = 1; k < o->nlevels; k++) {
+            lub_particles_free(&o->K[k].P);
+            free(o->K[k].fixed);
+            lub_neighbours_free(&o->K[k].cells);
+        }
     free(o->cand);
     memset(o, 0, sizeof *o);
 }
@@ -427,7 +430,9 @@ static size_t mark_fixed(lub_opt *o, int k)
 }
 
 /* The level whose particles give the values of a particle of level k at x: the other level
- * of the overlap x lies in, else the level owning x, else a neighbouring level. */
+ * of the overlap x lies in, else the neighbouring level on the side of the level owning x
+ * (k - 1 where a finer level owns x, k + 1 where a coarser one does), else a neighbouring
+ * level.  Always k - 1 or k + 1: the levels are coupled only at their boundaries. */
 static int source_level(const lub_opt *o, int k, double x)
 {
     lub_level_where w;
@@ -437,7 +442,8 @@ static int source_level(const lub_opt *o, int k, double x)
         if (b->fine == k) return b->coarse;
         if (b->coarse == k) return b->fine;
     }
-    if (w.owner != k) return w.owner;
+    if (w.owner < k) return k - 1;
+    if (w.owner > k) return k + 1;
     return k > 0 ? k - 1 : k + 1;
 }
 
@@ -502,8 +508,8 @@ static size_t cells_collect(const lub_neighbours *nb, int dim, const double x[3]
     return n;
 }
 
-/* A source of interpolated values: a level's particles now, or (sub-stepping) the coarser
- * level as it was at the start of its step, state K of T-20..T-22. */
+/* A source of interpolated values: a level's particles now, or (sub-stepping) a coarser
+ * level as it was at the start of its step, state K of T-20..T-22 (o->K). */
 typedef struct {
     const lub_particles *P;
     const uint8_t *fixed;
@@ -526,6 +532,25 @@ typedef struct {
     const source *old, *now;
     double w;
 } blend;
+
+/* The blend table of level A: for each source level B (A - 1 or A + 1, source_level) the
+ * states its values come from.  The finer level A - 1 is taken as it is now (at the start of
+ * A's step, or at its end after A's sub-steps); the coarser level A + 1, when old (its saved
+ * states K, sub-stepping) is given, in time between its state K and now (K + 1) with the
+ * weight w of state K (`moment`); without old, now alone. */
+static void blend_table(const lub_opt *o, int A, const source *now, const source *old,
+                        double moment, blend *tab)
+{
+    for (int B = 0; B < o->nlevels; B++) {
+        tab[B].old = NULL;
+        tab[B].now = &now[B];
+        tab[B].w = 0.0;
+    }
+    if (old && A + 1 < o->nlevels) {
+        tab[A + 1].old = &old[A + 1];
+        tab[A + 1].w = moment;
+    }
+}
 
 /* The source particles in the cells around x (the cells are at least re wide, so every
  * particle within re is among them): fluid and wall particles, without those given
@@ -611,19 +636,15 @@ static lub_lsq_result fit(const lub_opt *o, const blend *b, const double x[3], i
     return r1;
 }
 
-/* The blend level A's values at x come from: the source level (source_level) now, or in
- * time between old and now when old is that level's saved state. */
-static blend blend_for(const lub_opt *o, int A, double x, const source *now, const source *old,
-                       int old_level, double w)
+/* The blend level A's values at x come from: its source level's entry in the table. */
+static blend blend_for(const lub_opt *o, int A, double x, const blend *tab)
 {
-    const int B = source_level(o, A, x);
-    blend b = {B == old_level ? old : NULL, &now[B], w};
-    return b;
+    return tab[source_level(o, A, x)];
 }
 
-/* Interpolate the fixed particles of level A (marked) from their source levels. */
-static void couple_level(lub_opt *o, int A, const source *now, const source *old, int old_level,
-                         double w)
+/* Interpolate the fixed particles of level A (marked) from their source levels (tab:
+ * blend_table). */
+static void couple_level(lub_opt *o, int A, const blend *tab)
 {
     lub_particles *P = &o->P[A];
     const uint8_t *fix = o->m[A].fixed;
@@ -634,7 +655,7 @@ static void couple_level(lub_opt *o, int A, const source *now, const source *old
         if (!fix[i]) continue;
         size_t *cand = o->cand + (size_t)omp_get_thread_num() * o->cap_cand;
         const double xt[3] = {P->x[0][i], P->x[1][i], P->x[2][i]};
-        const blend b = blend_for(o, A, xt[0], now, old, old_level, w);
+        const blend b = blend_for(o, A, xt[0], tab);
         /* fluid: velocity and pressure; wall: pressure (its velocity is its patch's) */
         const int fluid = P->kind[i] == LUB_FLUID;
         double v[4];
@@ -659,8 +680,10 @@ void lub_opt_couple(lub_opt *o)
     for (int k = 0; k < o->nlevels; k++) o->st.nfixed[k] = mark_fixed(o, k);
     for (int k = 0; k < o->nlevels; k++) lub_neighbours_bin(&o->src[k], o->P[k].n, o->P[k].x);
     source now[LUB_MAX_LEVELS];
+    blend tab[LUB_MAX_LEVELS];
     for (int k = 0; k < o->nlevels; k++) now[k] = source_now(o, k);
-    for (int k = 0; k < o->nlevels; k++) couple_level(o, k, now, NULL, -1, 0.0);
+    blend_table(o, 0, now, NULL, 0.0, tab);
+    for (int k = 0; k < o->nlevels; k++) couple_level(o, k, tab);
 }
 
 /* ---- particle transfer ------------------------------------------------------------------- */
@@ -795,9 +818,8 @@ static int decide(lub_opt *o, int A, const double c[3], double dt, const blend *
 }
 
 /* Generation in level A's cells (A's and its sources' cell lists binned), after its step of
- * length dt; values from now[] or, for old_level, in time between old and now (w). */
-static void generate(lub_opt *o, int A, double dt, const source *now, const source *old,
-                     int old_level, double w)
+ * length dt; values from the source levels as the blend table tab gives them. */
+static void generate(lub_opt *o, int A, double dt, const blend *tab)
 {
     static const char *const gnames[3] = {"gradPx", "gradPy", "gradPz"};
     const size_t ng = o->ngen[A];
@@ -807,7 +829,7 @@ static void generate(lub_opt *o, int A, double dt, const source *now, const sour
     for (size_t q = 0; q < ng; q++) {
         size_t *cand = o->cand + (size_t)omp_get_thread_num() * o->cap_cand;
         const double *c = o->gen[A] + 3 * q;
-        const blend b = blend_for(o, A, c[0], now, old, old_level, w);
+        const blend b = blend_for(o, A, c[0], tab);
         ok[q] = (uint8_t)decide(o, A, c, dt, &b, cand, val + 7 * q);
     }
     /* append in cell order (the same on any number of threads) */
@@ -856,8 +878,10 @@ void lub_opt_transfer(lub_opt *o, double dt)
     for (int k = 0; k < o->nlevels; k++) lub_neighbours_bin(&o->src[k], o->P[k].n, o->P[k].x);
     o->st.nfull = 0;
     source now[LUB_MAX_LEVELS];
+    blend tab[LUB_MAX_LEVELS];
     for (int k = 0; k < o->nlevels; k++) now[k] = source_now(o, k);
-    for (int A = 0; A < o->nlevels; A++) generate(o, A, dt, now, NULL, -1, 0.0);
+    blend_table(o, 0, now, NULL, 0.0, tab);
+    for (int A = 0; A < o->nlevels; A++) generate(o, A, dt, tab);
     for (int k = 0; k < o->nlevels; k++) transfer_done(o, k);
     o->total_full += o->st.nfull;
 }
@@ -950,12 +974,12 @@ static lub_step_status step_level(lub_opt *o, int k, double dt, int *level, long
     return s;
 }
 
-/* Save the coarse level's state K (the source of the fine level's sub-steps) and bin it. */
-static void save_coarse(lub_opt *o)
+/* Save level k's state K (the source of the finer level's sub-steps) and bin it. */
+static void save_level(lub_opt *o, int k)
 {
-    const int c = o->nlevels - 1;
-    const lub_particles *P = &o->P[c];
-    lub_particles *K = &o->PK;
+    const lub_particles *P = &o->P[k];
+    lub_opt_saved *S = &o->K[k];
+    lub_particles *K = &S->P;
     K->n = P->n;
     for (int d = 0; d < 3; d++) {
         memcpy(K->x[d], P->x[d], P->n * sizeof(double));
@@ -963,60 +987,88 @@ static void save_coarse(lub_opt *o)
     }
     memcpy(K->p, P->p, P->n * sizeof(double));
     memcpy(K->kind, P->kind, P->n * sizeof *P->kind);
-    memcpy(o->fixK, o->m[c].fixed, P->n);
-    lub_neighbours_bin(&o->srcK, K->n, K->x);
+    memcpy(S->fixed, o->m[k].fixed, P->n);
+    lub_neighbours_bin(&S->cells, K->n, K->x);
 }
 
-/* One step of the coarse level (dt_coarse = Nr dt_fine, T-19) and Nr sub-steps of the fine
- * level, the fine level's bands and generation fed by the coarse values interpolated in time
- * between its states K and K + 1 (T-20..T-22 with the corrected weights; the thesis'
- * Fig. 3 order: the coarse level first, with the fine values at K). */
+/* One step of level k of length dt with sub-stepping (T-19..T-22), the thesis' Fig. 3 order
+ * applied recursively: level k is coupled (its band at the coarser level k + 1 from k + 1 in
+ * time between its states K and K + 1 at the start of this step, the b-th of Nr_k; its band at
+ * the finer level k - 1 from k - 1 now, at the start of the step), its state K saved, and it
+ * takes its step; then level k - 1 takes its Nr_{k-1} sub-steps of dt / Nr_{k-1} (each
+ * doing the same for the levels below it); last, level k's transfer at the end of its step
+ * (the coarser level at the weight of b + 1, the finer level as the sub-steps left it).
+ * now, old: the sources of every level now and (k >= 1) as saved. */
+static lub_step_status advance(lub_opt *o, int k, double dt, int b, const source *now,
+                               const source *old, int *level, long *bad, char *msg, size_t msgsize)
+{
+    const int top = o->nlevels - 1, nr = o->L.level[k].nr;
+    blend tab[LUB_MAX_LEVELS];
+    lub_step_status s;
+    lub_timer_start(&o->m[0].tm, LUB_T_OTHER);
+    if (k == top) {
+        for (int j = 0; j < o->nlevels; j++) o->st.nfixed[j] = mark_fixed(o, j);
+        for (int j = 0; j < o->nlevels; j++) lub_neighbours_bin(&o->src[j], o->P[j].n, o->P[j].x);
+    } else {
+        o->st.nfixed[k] = mark_fixed(o, k);
+        if (k > 0) { /* the finer level as its sub-steps left it: its given particles marked
+                        (not sources) and binned */
+            o->st.nfixed[k - 1] = mark_fixed(o, k - 1);
+            lub_neighbours_bin(&o->src[k - 1], o->P[k - 1].n, o->P[k - 1].x);
+        }
+    }
+    blend_table(o, k, now, old, lub_levels_time_weight(b, nr), tab);
+    couple_level(o, k, tab);
+    if (k > 0) save_level(o, k);
+    lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
+    if ((s = step_level(o, k, dt, level, bad, msg, msgsize)) != LUB_STEP_OK) return s;
+    if (k > 0) {
+        lub_neighbours_bin(&o->src[k], o->P[k].n, o->P[k].x); /* state K + 1 */
+        const int nf = o->L.level[k - 1].nr;
+        for (int c = 0; c < nf; c++)
+            if ((s = advance(o, k - 1, dt / nf, c, now, old, level, bad, msg, msgsize)) !=
+                LUB_STEP_OK)
+                return s;
+    }
+    /* level k's transfer, at the end of its step: time K + (b + 1) / Nr_k of the coarser */
+    lub_timer_start(&o->m[0].tm, LUB_T_OTHER);
+    const size_t nd = delete_outside(o, k), ng = o->st.ngenerated[k];
+    lub_neighbours_bin(&o->src[k], o->P[k].n, o->P[k].x);
+    if (k > 0) lub_neighbours_bin(&o->src[k - 1], o->P[k - 1].n, o->P[k - 1].x);
+    blend_table(o, k, now, old, lub_levels_time_weight(b + 1, nr), tab);
+    generate(o, k, dt, tab);
+    if (nd || o->st.ngenerated[k] != ng) lub_mps_rebuild_lists(&o->m[k]);
+    o->st.ndeleted[k] += nd;
+    lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
+    return LUB_STEP_OK;
+}
+
+/* One step of the coarsest level (dt = the product of the Nr times the finest dt, T-19) with
+ * every finer level's sub-steps (advance), then the mass count and correction. */
 static lub_step_status substeps(lub_opt *o, double dt, int *level, long *bad, char *msg,
                                 size_t msgsize)
 {
-    const int F = 0, C = 1, nr = o->nr;
-    const double dtf = dt / nr;
-    lub_step_status s;
-    source now[LUB_MAX_LEVELS];
-    /* the coarse level: its band from the fine level at K */
-    lub_timer_start(&o->m[0].tm, LUB_T_OTHER);
-    o->st.nlower = o->st.nempty = 0;
-    for (int k = 0; k < o->nlevels; k++) o->st.nfixed[k] = mark_fixed(o, k);
-    for (int k = 0; k < o->nlevels; k++) lub_neighbours_bin(&o->src[k], o->P[k].n, o->P[k].x);
-    for (int k = 0; k < o->nlevels; k++) now[k] = source_now(o, k);
-    couple_level(o, C, now, NULL, -1, 0.0);
-    save_coarse(o);
-    const source old = {&o->PK, o->fixK, &o->srcK, &o->lsq[C], o->m[C].re, o->m[C].n0, o->fill[C]};
-    lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
-    if ((s = step_level(o, C, dt, level, bad, msg, msgsize)) != LUB_STEP_OK) return s;
-    lub_neighbours_bin(&o->src[C], o->P[C].n, o->P[C].x); /* state K + 1 */
-    o->st.nfull = 0;
-    o->st.ndeleted[F] = o->st.ngenerated[F] = 0;
-    for (int b = 0; b < nr; b++) {
-        lub_timer_start(&o->m[0].tm, LUB_T_OTHER);
-        o->st.nfixed[F] = mark_fixed(o, F);
-        couple_level(o, F, now, &old, C, lub_levels_time_weight(b, nr));
-        lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
-        if ((s = step_level(o, F, dtf, level, bad, msg, msgsize)) != LUB_STEP_OK) return s;
-        lub_timer_start(&o->m[0].tm, LUB_T_OTHER);
-        const size_t nd = delete_outside(o, F), ng = o->st.ngenerated[F];
-        lub_neighbours_bin(&o->src[F], o->P[F].n, o->P[F].x);
-        /* at the end of sub-step b: time K + (b + 1) / Nr */
-        generate(o, F, dtf, now, &old, C, lub_levels_time_weight(b + 1, nr));
-        if (nd || o->st.ngenerated[F] != ng) lub_mps_rebuild_lists(&o->m[F]);
-        o->st.ndeleted[F] += nd;
-        lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);
+    source now[LUB_MAX_LEVELS], old[LUB_MAX_LEVELS];
+    for (int k = 0; k < o->nlevels; k++) {
+        now[k] = source_now(o, k);
+        old[k] = now[k];
+        if (k > 0) {
+            lub_opt_saved *S = &o->K[k];
+            old[k].P = &S->P;
+            old[k].fixed = S->fixed;
+            old[k].cells = &S->cells;
+        }
     }
-    /* the coarse level's transfer, from the fine level at K + 1 */
+    o->st.nlower = o->st.nempty = 0;
+    o->st.nfull = 0;
+    for (int k = 0; k < o->nlevels; k++) o->st.ndeleted[k] = o->st.ngenerated[k] = 0;
+    lub_step_status s = advance(o, o->nlevels - 1, dt, 0, now, old, level, bad, msg, msgsize);
+    if (s != LUB_STEP_OK) return s;
     lub_timer_start(&o->m[0].tm, LUB_T_OTHER);
-    o->total_deleted[F] += o->st.ndeleted[F];
-    o->total_generated[F] += o->st.ngenerated[F];
-    o->st.ndeleted[C] = delete_outside(o, C);
-    o->st.ngenerated[C] = 0;
-    lub_neighbours_bin(&o->src[C], o->P[C].n, o->P[C].x);
-    lub_neighbours_bin(&o->src[F], o->P[F].n, o->P[F].x);
-    generate(o, C, dt, now, NULL, -1, 0.0);
-    transfer_done(o, C);
+    for (int k = 0; k < o->nlevels; k++) {
+        o->total_deleted[k] += o->st.ndeleted[k];
+        o->total_generated[k] += o->st.ngenerated[k];
+    }
     o->total_full += o->st.nfull;
     mass_correct(o, dt);
     lub_timer_stop(&o->m[0].tm, LUB_T_OTHER);

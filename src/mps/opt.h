@@ -7,7 +7,10 @@
  * regions): in the fixed band at the far edge of each level's overlap (T-25, T-26) the level's
  * particles are not computed, their velocity and pressure are given, interpolated by weighted
  * least squares (mps/lsq.h) from the other level's particles, and each level's free particles
- * see them as boundary values:
+ * see them as boundary values.  Any number of levels from 2 up (LUB_MAX_LEVELS): level k is
+ * coupled with its neighbours k - 1 and k + 1 only, at the boundaries between them, so a
+ * middle level has fixed bands at both ends of each piece of its ring (given by the finer
+ * level at its hole, by the coarser level at its outer edges):
  *
  *     viscosity (T-31):  the band's velocities are Dirichlet values of the implicit solve
  *                        (§2-2-2 (3): velocities fixed outside L_outer);
@@ -58,12 +61,12 @@
  * level in its memory order: a restart splits the file into the same arrays, so it repeats
  * the uninterrupted run exactly.
  *
- * Time steps.  Every level takes the same dt (commonDeltaT, T-60), or, with two levels, the
- * coarse level takes dt_coarse = Nr dt_fine (T-19) while the fine level takes Nr sub-steps
- * (lub_opt_step).
+ * Time steps.  Every level takes the same dt (commonDeltaT, T-60), or level k + 1 takes
+ * dt_{k+1} = Nr_k dt_k (T-19) while level k takes Nr_k sub-steps, recursively down to level
+ * 0 (lub_opt_step): one step of the coarsest level is the product of the Nr finest steps.
  *
  * Mass correction (T-27..T-29, T-61; massCorrection in multiResolution).  After each step
- * (each coarse step when sub-stepping) the mass M of T-27 is counted; when
+ * (each step of the coarsest level when sub-stepping) the mass M of T-27 is counted; when
  * |M - M^0| > threshold M^0 the coarser level's fluid particles in each overlap (outside its
  * fixed band, which is given anyway) move with the x-velocity correction
  *
@@ -72,7 +75,10 @@
  * s = +1 at a boundary where the fine level owns the x below it (a2), -1 where it owns the x
  * above it (a1); A is the summed cross-section of the overlaps' fluid (the fine level's fluid
  * particles in each overlap times l0_fine^d over the overlap's length: the film thickness in
- * 2-D, per unit depth) and dt the coarser level's step.  Why one level and this sign: the
+ * 2-D, per unit depth) and dt the coarsest level's step.  With more than two levels each
+ * boundary between levels k and k + 1 corrects level k + 1's fluid in its own overlap with
+ * its own s (a middle level is the coarser level of its inner boundaries only).  Why one
+ * level and this sign: the
  * levels conserve their own particles except at the far edges of their extended regions
  * (deletion, generation), which lie away from the boundary a where the ownership of T-27
  * changes, so M changes only by the two levels' fluxes through a,
@@ -138,6 +144,14 @@ typedef struct {
     size_t ncorrected; /* particles given the correction */
 } lub_opt_stats;
 
+/* A level's state K (sub-stepping): positions, velocities, pressures, kinds and given flags
+ * at the start of its step, binned. */
+typedef struct {
+    lub_particles P;
+    uint8_t *fixed;
+    lub_neighbours cells;
+} lub_opt_saved;
+
 typedef struct {
     lub_levels L;
     int nlevels, dim;
@@ -163,13 +177,12 @@ typedef struct {
     uint8_t *gen_ok[LUB_MAX_LEVELS]; /* decision of the last pass */
     double fill[LUB_MAX_LEVELS];     /* fill fraction of the level's fluid at its surface */
 
-    /* sub-stepping (T-19..T-22): the fine level takes nr steps per coarse step; the coarse
-     * level's state K (positions, velocities, pressures, kinds, given flags) is kept for the
-     * fine level's values between K and K + 1 */
+    /* sub-stepping (T-19..T-22): nr steps of the finest level per step of the coarsest (the
+     * product of the Nr; 1 with commonDeltaT); the state K of every coarser level k >= 1 at
+     * the start of its current step is kept for the finer level's values between K and K + 1
+     * (allocated at set-up when nr > 1) */
     int nr;
-    lub_particles PK;
-    uint8_t *fixK;
-    lub_neighbours srcK;
+    lub_opt_saved K[LUB_MAX_LEVELS];
     double *gen_val[LUB_MAX_LEVELS]; /* u (3), p, grad p (3) per cell */
 
     double rho;   /* density (the mass of T-27) */
@@ -197,15 +210,23 @@ void lub_opt_free(lub_opt *o);
 void lub_opt_moving_wall(lub_opt *o, const lub_geometry *g, int patch);
 
 /* One step of length dt on every level: flags the fixed bands, interpolates their velocity
- * and pressure from the other level, then lub_mps_step on each level, then the particle
- * transfer (lub_opt_transfer).  With sub-stepping (nr > 1) dt is the coarse level's step: the
- * coarse level takes it (its band from the fine level at the start, state K), then the fine
- * level takes nr steps of dt / nr, its bands and generation fed by the coarse values
- * interpolated in time between K and K + 1 with the weights of lub_levels_time_weight
- * (T-20..T-22 corrected: (Nr - b)/Nr for K at sub-step b); the coarse level's transfer
- * follows, from the fine level at K + 1.  Last, the mass count and correction (T-27..T-29,
- * above) with the coarse dt.  On failure *level is the level, *bad the particle
- * index in it and msg names the level; as lub_mps_step. */
+ * and pressure from the neighbouring levels, then lub_mps_step on each level, then the
+ * particle transfer (lub_opt_transfer).  With sub-stepping (nr > 1) dt is the coarsest
+ * level's step, and each level k from the coarsest down takes one step of its dt_k as
+ * follows (the thesis' Fig. 3 order, recursively):
+ *   - its bands are interpolated: at its boundaries with the coarser level k + 1 from k + 1's
+ *     state K (saved at the start of k + 1's current step) and its state K + 1 (now), in
+ *     time with the weights of lub_levels_time_weight (T-20..T-22 corrected: (Nr_k - b)/Nr_k
+ *     for K at k's sub-step b); at its boundaries with the finer level k - 1 from k - 1 as it
+ *     is, at the start of k's step;
+ *   - its state K is saved (k >= 1), it takes its step, then level k - 1 takes its Nr_{k-1}
+ *     sub-steps of dt_k / Nr_{k-1} in the same way;
+ *   - its transfer follows, at the end of its step: from k + 1 at the weight of b + 1, from
+ *     k - 1 as its sub-steps left it (at the same time).
+ * For two levels: the coarse level's step (its band from the fine level at K), the fine
+ * level's Nr sub-steps, the coarse level's transfer from the fine level at K + 1.  Last, the
+ * mass count and correction (T-27..T-29, above) with the coarsest dt.  On failure *level is
+ * the level, *bad the particle index in it and msg names the level; as lub_mps_step. */
 lub_step_status lub_opt_step(lub_opt *o, double dt, int *level, long *bad, char *msg,
                              size_t msgsize);
 

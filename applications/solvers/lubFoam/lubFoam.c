@@ -154,7 +154,7 @@ static void print_header(const lubfoam_run *r)
                     w->e.clamp, w->h0, w->samples);
         if (w->nlevels > 1) {
             /* the segments of the deformation and the load: each point of x on one level */
-            char lv[512];
+            char lv[128 * LUB_MAX_LEVELS];
             size_t len = 0;
             for (int k = 0; k < w->nlevels && len < sizeof lv; k++) {
                 int owned = 0;
@@ -204,7 +204,9 @@ static void log_line(const lubfoam_run *r, long steps_done, double wall0, double
         const lub_opt *o = r->opt;
         lub_opt_mass mc;
         lub_opt_mass_count(o, &mc);
-        char lv[512];
+        /* room for every level: its part is at most about 180 characters (the counts with 20
+         * digits), and the given-in-a-wall note 40 */
+        char lv[256 * LUB_MAX_LEVELS];
         size_t len = 0;
         for (int k = 0; k < o->nlevels && len < sizeof lv; k++)
             len += (size_t)snprintf(
@@ -380,8 +382,8 @@ int main(int argc, char **argv)
     double pit_sum = 0, vit_sum = 0, last_bar = 0;
     int warned_courant = 0, warned_full = 0, status = LUB_EXIT_OK;
 
-    /* multi-resolution with sub-stepping: one pass of the loop is one step of the coarse level,
-     * nr steps of deltaT (dt below) on the fine level */
+    /* multi-resolution with sub-stepping: one pass of the loop is one step of the coarsest
+     * level, nr steps of deltaT (dt below) on the finest level (nr: the product of the Nr) */
     const int nr = r.opt ? r.opt->nr : 1;
     while (!lub_control_finished(&r.ctl, r.t, steps, r.dt)) {
         if (r.ctl.adjust_time_step && r.opt) {
