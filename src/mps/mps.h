@@ -152,12 +152,17 @@ typedef struct {
     double *cav;     /* negativePressure cavitation: 1 where the pressure is held at 0 (particle
                         extra field "cavitation", so that it is saved and reordered), else NULL */
     double *lap;
-    uint8_t *fixed; /* multi-resolution fixed band (T-25, T-26; mps/opt.h): 1 where a fluid or
-                       wall particle's velocity and pressure are given (interpolated from another
-                       level before the step): such a particle is a Dirichlet row of the
-                       viscosity (fluid) and pressure equations, keeps its velocity through the
-                       step and moves with it (r* = r + u dt, no correction, no collision).
-                       Reordered with the particles.  NULL unless config.fixed_flags. */
+    uint8_t *fixed;  /* multi-resolution fixed band (T-25, T-26; mps/opt.h): 1 where a fluid or
+                        wall particle's velocity and pressure are given (interpolated from another
+                        level before the step): such a particle is a Dirichlet row of the
+                        viscosity (fluid) and pressure equations, keeps its velocity through the
+                        step and moves with it (r* = r + u dt, no correction, no collision).
+                        Reordered with the particles.  NULL unless config.fixed_flags. */
+    uint8_t *inside; /* multi-resolution: 1 where another level's particles fill the
+                        neighbourhood (their PND at the particle's position is at least beta
+                        n0 of that level), so the particle is not on a free surface whatever
+                        its own PND (mps/opt.h, Free surface in the overlaps).  Set before the
+                        step, reordered with the particles.  NULL unless config.fixed_flags. */
     void *scratch;
     long steps; /* global step count (from the particle file) */
     int built;  /* neighbour lists built once */

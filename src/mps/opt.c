@@ -642,10 +642,54 @@ static blend blend_for(const lub_opt *o, int A, double x, const blend *tab)
     return tab[source_level(o, A, x)];
 }
 
+/* Free surface in the overlaps (opt.h): mark the computed fluid and wall particles of level A
+ * in an overlap where the other level's particles (every kind, as the PND of T-11) fill the
+ * neighbourhood, their PND at the particle's position at least beta n0 of that level. */
+static void mark_inside(lub_opt *o, int A, const blend *tab)
+{
+    lub_particles *P = &o->P[A];
+    const uint8_t *fix = o->m[A].fixed;
+    uint8_t *in = o->m[A].inside;
+    const int dim = o->dim;
+    size_t nin = 0;
+#pragma omp parallel for schedule(dynamic, 64) reduction(+ : nin)
+    for (size_t i = 0; i < P->n; i++) {
+        in[i] = 0;
+        if (P->kind[i] == LUB_DUMMY || fix[i]) continue;
+        lub_level_where w;
+        lub_levels_locate(&o->L, P->x[0][i], &w);
+        if (w.boundary < 0) continue;
+        const lub_level_boundary *b = &o->L.boundary[w.boundary];
+        if (b->fine != A && b->coarse != A) continue;
+        const int B = b->fine == A ? b->coarse : b->fine;
+        const source *S = tab[B].now;
+        const double xt[3] = {P->x[0][i], P->x[1][i], P->x[2][i]};
+        size_t *cand = o->cand + (size_t)omp_get_thread_num() * o->cap_cand;
+        const size_t nc = cells_collect(S->cells, dim, xt, cand);
+        const lub_particles *Q = S->P;
+        const double *L = S->cells->period;
+        const int *per = S->cells->periodic;
+        double pnd = 0.0;
+        for (size_t q = 0; q < nc; q++) {
+            const size_t j = cand[q];
+            double r2 = 0.0;
+            for (int d = 0; d < dim; d++) {
+                const double v = lub_min_image(Q->x[d][j] - xt[d], per[d] ? L[d] : 0.0);
+                r2 += v * v;
+            }
+            pnd += lub_mps_weight(sqrt(r2), S->re);
+        }
+        in[i] = pnd >= o->m[B].c.beta * S->n0;
+        nin += in[i];
+    }
+    o->st.ninside[A] = nin;
+}
+
 /* Interpolate the fixed particles of level A (marked) from their source levels (tab:
- * blend_table). */
+ * blend_table), and mark its particles inside the other level's fluid (mark_inside). */
 static void couple_level(lub_opt *o, int A, const blend *tab)
 {
+    mark_inside(o, A, tab);
     lub_particles *P = &o->P[A];
     const uint8_t *fix = o->m[A].fixed;
     const int dim = o->dim;

@@ -33,6 +33,20 @@
  * exactly; where the neighbours cannot fix it (near a wall on a coarse level) it falls back to
  * first order or to the weighted mean, and the fallbacks are counted (lub_opt_stats).
  *
+ * Free surface in the overlaps.  The band particles are not pushed apart by the pressure, so
+ * next to a band a level's particles come to stand irregularly, and a computed particle there
+ * can see a hole on one side: its PND falls below beta n0 with a one-sided neighbourhood, the
+ * free-surface test of T-12 (step.c) flags it, it gets P = 0 among neighbours at the film's
+ * pressure, and the pressure gradient throws it out of the film (the thesis OPT wedge: a
+ * coarse particle next to the band at a1, 25 m/s after 6.3 ms).  The other level is computed
+ * freely there and knows whether the place is full of fluid: a computed particle in an
+ * overlap is marked inside (lub_mps.inside) when the other level's particles' PND at its
+ * position, with that level's re, is at least beta n0 of that level, and an inside particle is
+ * not a surface particle.  At a real free surface (a layer's top, a film's rupture crossing
+ * the overlap) the other level's PND is deficient as well, and the test is the usual one.
+ * (The thesis uses the virtual-light test, which by itself sees such an interior hole as
+ * shadowed.)
+ *
  * Given particles and curved walls.  A band particle moves with its interpolated velocity,
  * without the pressure that keeps computed particles off the walls; where the wall is curved
  * (the cylinder at a1) the other level's coarser velocity field can carry it into the wall.
@@ -137,6 +151,8 @@ typedef struct {
     size_t ngenerated[LUB_MAX_LEVELS]; /* fluid particles generated in the generation layers */
     size_t nfull;                      /* generations skipped: the level's capacity is full */
     size_t nburied[LUB_MAX_LEVELS];    /* given fluid particles deleted behind a wall */
+    size_t ninside[LUB_MAX_LEVELS];    /* computed particles in an overlap inside the other
+                                          level's fluid (no free surface there) */
     long piter, viter; /* pressure and viscosity iterations of all the level steps taken */
     double mass;       /* M (T-27) after the step [kg, or kg/m in 2-D] */
     double correction; /* the mass correction's B sgn(M - M^0) of the step [m/s], 0 if none */

@@ -76,6 +76,7 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
     m->prow = lub_calloc(n ? n : 1, sizeof *m->prow);
     m->scratch = lub_malloc((n ? n : 1) * sizeof(double));
     m->fixed = c->fixed_flags ? lub_calloc(n ? n : 1, 1) : NULL;
+    m->inside = c->fixed_flags ? lub_calloc(n ? n : 1, 1) : NULL;
     for (int k = 0; k < LUB_T_COUNT; k++) lub_timers_add(&m->tm, lub_mps_phase_names[k]);
 }
 
@@ -96,6 +97,7 @@ void lub_mps_free(lub_mps *m)
     free(m->prow);
     free(m->scratch);
     free(m->fixed);
+    free(m->inside);
     lub_neighbours_free(&m->nb);
     lub_csr_free(&m->A);
     lub_linsolver_free(&m->psolver);
@@ -109,8 +111,8 @@ static void reorder(lub_mps *m)
     lub_particles *P = m->P;
     double *x[3] = {P->x[0], P->x[1], P->x[2]};
     lub_neighbours_order(&m->nb, P->n, x);
-    void *arrays[12 + LUB_MAX_EXTRA];
-    size_t sizes[12 + LUB_MAX_EXTRA];
+    void *arrays[16 + LUB_MAX_EXTRA];
+    size_t sizes[16 + LUB_MAX_EXTRA];
     int k = 0;
     for (int d = 0; d < 3; d++) {
         arrays[k] = P->x[d], sizes[k++] = sizeof(double);
@@ -123,6 +125,7 @@ static void reorder(lub_mps *m)
     arrays[k] = P->id, sizes[k++] = sizeof *P->id;
     for (int e = 0; e < P->nextra; e++) arrays[k] = P->extra[e].v, sizes[k++] = sizeof(double);
     if (m->fixed) arrays[k] = m->fixed, sizes[k++] = sizeof *m->fixed;
+    if (m->inside) arrays[k] = m->inside, sizes[k++] = sizeof *m->inside;
     lub_reorder_set(P->n, m->nb.perm, m->scratch, k, arrays, sizes);
 }
 
@@ -320,7 +323,9 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
 /* Free surface (T-12): n* < beta n0, kept only when the neighbourhood is one-sided: the
  * weighted centroid of the neighbours is further than `asymmetry` l0 from the particle.
  * This geometric refinement plays the role of the thesis' virtual-light test: an interior
- * particle whose PND dropped (a transient rarefaction) has neighbours all around it. */
+ * particle whose PND dropped (a transient rarefaction) has neighbours all around it.  In a
+ * multi-resolution overlap (m->inside, set by mps/opt.c) a particle where the other level's
+ * particles fill the neighbourhood is not on a surface, whatever its own PND. */
 static void free_surface(lub_mps *m)
 {
     lub_particles *P = m->P;
@@ -341,7 +346,7 @@ static void free_surface(lub_mps *m)
             }
             if (wpres <= 0) {
                 s = 1; /* no pressure neighbour: nothing to couple to */
-            } else if (m->pnd[i] < lim) {
+            } else if (m->pnd[i] < lim && !(m->inside && m->inside[i])) {
                 double off = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) / wsum;
                 s = (asym <= 0 || off > asym);
             }

@@ -770,6 +770,104 @@ static void test_three_mass_correction_substeps(void)
         if (!only_ || strstr(#fn, only_)) RUN(fn);                                                 \
     } while (0)
 
+/* Free surface in the overlaps (opt.h): a particle where the other level's particles fill
+ * the neighbourhood is not on a surface, whatever its own PND.  (a) The full channel at rest
+ * with a hole in each level's computed part of the overlap [18, 42] mm (coarse: radius
+ * 2.5 mm at x = 26 mm, in the coarse level's own part; fine: radius 1.2 mm at x = 32 mm, in
+ * the fine level's own part; both at mid-height): the particles around a hole have a PND
+ * below beta n0, yet none is a surface particle, since the other level fills the place;
+ * (b) a layer with a free top crossing the overlap: its top row is a surface on both levels
+ * there (the other level's PND is deficient too) and the particles 3 l0 or more below it
+ * are not. */
+static const char *free_layer = "dimension: 2\n"
+                                "levels:\n"
+                                "  - { l0: 0.001, region: [0.03, 0.07] }\n"
+                                "  - { l0: 0.002 }\n"
+                                "domain: { min: [0, -0.008], max: [0.12, 0.03] }\n"
+                                "periodic: [x]\n"
+                                "walls:\n"
+                                "  lower: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+                                "fluid:\n"
+                                "  - { type: box, min: [0.015, 0], max: [0.035, 0.01] }\n";
+
+static void drop_disc(lub_particles *P, int level, double cx, double cy, double r)
+{
+    size_t n = 0;
+    for (size_t i = 0; i < P->n; i++) {
+        const double dx = P->x[0][i] - cx, dy = P->x[1][i] - cy;
+        if (P->kind[i] == LUB_FLUID && P->level[i] == level && dx * dx + dy * dy < r * r) continue;
+        for (int d = 0; d < 3; d++) P->x[d][n] = P->x[d][i], P->u[d][n] = P->u[d][i];
+        P->p[n] = P->p[i], P->kind[n] = P->kind[i], P->patch[n] = P->patch[i];
+        P->level[n] = P->level[i], P->id[n] = P->id[i];
+        n++;
+    }
+    P->n = n;
+}
+
+static void test_surface_overlap(void)
+{
+    two_levels t;
+    generate(channel, &t.P, &t.g);
+    drop_disc(&t.P, 1, 0.026, 0.010, 0.0025);
+    drop_disc(&t.P, 0, 0.032, 0.010, 0.0012);
+    read_levels(&t.L, "multiResolution: { commonDeltaT: true }\n", &t.g);
+    lub_mps_config c;
+    lub_mps_config_defaults(&c);
+    c.rho = 1000;
+    c.nu = 1e-3;
+    c.viscosity = LUB_VISCOSITY_CN;
+    c.alpha = 1e-6 / (1e-3 * 1e-3);
+    lub_opt_init(&t.o, &t.L, &t.P, &c, &t.g, 0.0);
+    double dm;
+    CHECK(run(&t, 1e-3, 1, 1, &dm) == 0);
+    const double hole[2][3] = {{0.032, 0.010, 0.0012}, {0.026, 0.010, 0.0025}};
+    for (int k = 0; k < 2; k++) {
+        const lub_particles *Q = &t.o.P[k];
+        const lub_mps *m = &t.o.m[k];
+        size_t nsurf = 0, nlow = 0, nin = 0;
+        for (size_t i = 0; i < Q->n; i++) {
+            if (Q->kind[i] != LUB_FLUID || m->fixed[i]) continue;
+            const double x = Q->x[0][i];
+            if (x < 0.018 || x > 0.042) continue;
+            nsurf += m->surface[i];
+            nin += m->inside[i];
+            const double dx = x - hole[k][0], dy = Q->x[1][i] - hole[k][1];
+            if (sqrt(dx * dx + dy * dy) < hole[k][2] + 1.5 * m->l0 && m->pnd[i] < c.beta * m->n0)
+                nlow++;
+        }
+        printf("  hole in level %d: %zu particles next to it below beta n0, %zu computed "
+               "particles in the overlap inside the other level's fluid, %zu surface\n",
+               k, nlow, nin, nsurf);
+        CHECK(nlow > 0);
+        CHECK(nsurf == 0);
+    }
+    teardown(&t);
+
+    /* (b) a layer 10 mm deep with a free top, across the overlap */
+    generate(free_layer, &t.P, &t.g);
+    read_levels(&t.L, "multiResolution: { commonDeltaT: true }\n", &t.g);
+    lub_opt_init(&t.o, &t.L, &t.P, &c, &t.g, 0.0);
+    CHECK(run(&t, 1e-3, 1, 1, &dm) == 0);
+    for (int k = 0; k < 2; k++) {
+        const lub_particles *Q = &t.o.P[k];
+        const lub_mps *m = &t.o.m[k];
+        const double l0 = m->l0;
+        size_t ntop = 0, ntopsurf = 0, ndeep = 0, ndeepsurf = 0;
+        for (size_t i = 0; i < Q->n; i++) {
+            if (Q->kind[i] != LUB_FLUID || m->fixed[i]) continue;
+            const double x = Q->x[0][i], y = Q->x[1][i];
+            if (x < 0.018 + 3 * l0 || x > 0.034 - 3 * l0) continue; /* both levels computed */
+            if (y > 0.010 - l0) ntop++, ntopsurf += m->surface[i];
+            if (y < 0.010 - 3 * l0) ndeep++, ndeepsurf += m->surface[i];
+        }
+        printf("  layer, level %d: top row %zu of %zu surface, %zu of %zu deeper ones\n", k,
+               ntopsurf, ntop, ndeepsurf, ndeep);
+        CHECK(ntop > 0 && ntopsurf == ntop);
+        CHECK(ndeep > 0 && ndeepsurf == 0);
+    }
+    teardown(&t);
+}
+
 int main(void)
 {
     RUN_SELECTED(test_split);
@@ -777,6 +875,7 @@ int main(void)
     RUN_SELECTED(test_poiseuille);
     RUN_SELECTED(test_couette_transfer);
     RUN_SELECTED(test_column);
+    RUN_SELECTED(test_surface_overlap);
     RUN_SELECTED(test_mass_correction);
     RUN_SELECTED(test_substeps);
     RUN_SELECTED(test_three_couette);
