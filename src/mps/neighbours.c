@@ -445,15 +445,13 @@ static inline void update_particle(lub_neighbours *nb, double *const x[3], size_
     }
 }
 
-size_t lub_neighbours_update(lub_neighbours *nb, double *const x[3])
+size_t lub_neighbours_moved(const lub_neighbours *nb, double *const x[3], double lim)
 {
     const size_t n = nb->n;
     const int dim = nb->dim;
-    const double lim = 0.5 * (nb->rs - nb->re);
     double L[3];
     for (int d = 0; d < 3; d++) L[d] = d < dim && nb->periodic[d] ? nb->period[d] : 0.0;
-    /* First the displacements since the build (positions then: xs, wrapped; minimum image):
-     * when a rebuild is due the pairs are not worth updating. */
+    /* displacement since the build (positions then: xs, wrapped), minimum image */
     size_t moved = 0;
 #pragma omp parallel for schedule(static) reduction(+ : moved)
     for (size_t i = 0; i < n; i++) {
@@ -464,6 +462,17 @@ size_t lub_neighbours_update(lub_neighbours *nb, double *const x[3])
         }
         if (!(d2 <= lim * lim)) moved++;
     }
+    return moved;
+}
+
+size_t lub_neighbours_update(lub_neighbours *nb, double *const x[3])
+{
+    const size_t n = nb->n;
+    const int dim = nb->dim;
+    double L[3];
+    for (int d = 0; d < 3; d++) L[d] = d < dim && nb->periodic[d] ? nb->period[d] : 0.0;
+    /* when a rebuild is due the pairs are not worth updating */
+    const size_t moved = lub_neighbours_moved(nb, x, 0.5 * (nb->rs - nb->re));
     if (moved) return moved;
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {

@@ -121,6 +121,11 @@ size_t lub_neighbours_build(lub_neighbours *nb, size_t n, double *const x[3]);
  * skin re / 2 since the build; returns the number of particles that moved further (0: the
  * lists are complete and updated; otherwise they are left as they were: rebuild). */
 size_t lub_neighbours_update(lub_neighbours *nb, double *const x[3]);
+/* The number of particles that moved further than lim from their position at the last build
+ * (minimum image).  The lists hold every pair now closer than re - 2 lim while it is 0: a
+ * sweep over a shorter distance (the collision model's) can use them with the current
+ * positions (lub_neighbours_r). */
+size_t lub_neighbours_moved(const lub_neighbours *nb, double *const x[3], double lim);
 
 /* Minimum image of a coordinate difference v for period L (L = 0: not periodic).  Positions
  * kept within the box need at most one period added or removed; the floor is the rare

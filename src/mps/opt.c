@@ -669,6 +669,7 @@ static void mark_inside(lub_opt *o, int A, const blend *tab)
         const lub_particles *Q = S->P;
         const double *L = S->cells->period;
         const int *per = S->cells->periodic;
+        const double re2 = S->re * S->re;
         double pnd = 0.0;
         for (size_t q = 0; q < nc; q++) {
             const size_t j = cand[q];
@@ -677,7 +678,7 @@ static void mark_inside(lub_opt *o, int A, const blend *tab)
                 const double v = lub_min_image(Q->x[d][j] - xt[d], per[d] ? L[d] : 0.0);
                 r2 += v * v;
             }
-            pnd += lub_mps_weight(sqrt(r2), S->re);
+            if (r2 < re2) pnd += lub_mps_weight(sqrt(r2), S->re);
         }
         in[i] = pnd >= o->m[B].c.beta * S->n0;
         nin += in[i];

@@ -489,7 +489,8 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
  * velocity, with restitution e: half of (1 + e) of it against a fluid particle (equal
  * masses), all of it against a wall or dummy particle (infinite mass).  Each particle's
  * change is computed from the velocities before the collision step, so the result does not
- * depend on the order or the number of threads. */
+ * depend on the order or the number of threads.  The pairs are those of the lists at r*
+ * (lub_mps_step checks that they are complete), at the current positions. */
 static void collision(lub_mps *m, double dt)
 {
     lub_particles *P = m->P;
@@ -497,20 +498,21 @@ static void collision(lub_mps *m, double dt)
     const size_t n = P->n;
     const double dc = m->c.collision_distance * m->l0, e = m->c.restitution;
     double *du[3] = {m->grad[0], m->grad[1], m->grad[2]};
+    double *x[3] = {P->x[0], P->x[1], P->x[2]};
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         double acc[3] = {0, 0, 0};
         /* a fixed-band particle keeps its given velocity (it still stops the others) */
         if (P->kind[i] == LUB_FLUID && !(m->fixed && m->fixed[i])) {
             for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
-                double r2 = 0;
-                for (int d = 0; d < m->dim; d++) r2 += nb->dx[d][q] * nb->dx[d][q];
+                const size_t j = nb->j[q];
+                double v[3];
+                const double r2 = lub_neighbours_r(nb, x, i, j, v); /* now, not at the build */
                 if (r2 >= dc * dc || r2 <= 0) continue;
                 const double r = sqrt(r2);
-                size_t j = nb->j[q];
                 double vn = 0, ev[3] = {0, 0, 0};
                 for (int d = 0; d < m->dim; d++) {
-                    ev[d] = nb->dx[d][q] / r;
+                    ev[d] = v[d] / r;
                     vn += (P->u[d][i] - P->u[d][j]) * ev[d];
                 }
                 if (vn <= 0) continue; /* separating */
@@ -938,7 +940,14 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
 
     /* 9. collision, periodic wrap, checks */
     if (m->c.collision) {
-        neighbours(m, 0);
+        /* the lists of r* hold every pair now closer than the collision distance while no
+         * particle moved (r* to now: the correction) more than half their difference */
+        lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
+        double *x[3] = {P->x[0], P->x[1], P->x[2]};
+        const double lim = 0.5 * (m->re - m->c.collision_distance * m->l0);
+        const int rebuild = lub_neighbours_moved(&m->nb, x, lim) != 0;
+        lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
+        if (rebuild) neighbours(m, 1);
         lub_timer_start(&m->tm, LUB_T_OTHER);
         collision(m, dt);
         lub_timer_stop(&m->tm, LUB_T_OTHER);

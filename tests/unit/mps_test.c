@@ -874,11 +874,15 @@ static void test_update(void)
         err = fmax(err, fabs(pnd[i] - s));
     }
     CHECK(err < 1e-12);
+    /* lub_neighbours_moved: displacements since the build were below 0.0707 re */
+    CHECK(lub_neighbours_moved(&nb, c.x, 0.071 * re) == 0);
+    CHECK(lub_neighbours_moved(&nb, c.x, 0.0) == c.n);
     /* a particle beyond skin re / 2: rebuild; the lists are left as they were */
     const double dx0 = nb.dx[0][nb.start[5]];
     c.x[0][5] += 0.2 * re;
     CHECK(lub_neighbours_update(&nb, c.x) == 1);
     CHECK(nb.dx[0][nb.start[5]] == dx0);
+    CHECK(lub_neighbours_moved(&nb, c.x, 0.071 * re) == 1);
     free(pnd);
     lub_neighbours_free(&nb);
     cloud_free(&c);
