@@ -112,6 +112,14 @@ static void reference_solve(reference *f, const lub_case *c)
     f->st = lub_refcase_solve(&f->rc, &f->G, f->p, &f->res);
 }
 
+static void reference_free(reference *f)
+{
+    free(f->p);
+    lub_refgap_free(&f->G);
+    lub_refcase_free(&f->rc);
+    free(f);
+}
+
 /* p at x by linear interpolation on the reference's grid (x inside it). */
 static double reference_p(const reference *f, double x)
 {
@@ -136,7 +144,7 @@ static void check_reynolds(const lub_levels *L, const lub_case *c)
         return;
     }
     /* errors of the reference's dictionaries become a warning; what they allocated before
-     * the error is left (once, at start-up) */
+     * the error is freed with the reference (f is zeroed: the frees take a partial one) */
     reference *f = lub_calloc(1, sizeof *f);
     double t0 = lub_wtime();
     lub_catcher catcher;
@@ -147,6 +155,7 @@ static void check_reynolds(const lub_levels *L, const lub_case *c)
         lub_warning("multiResolution: the boundaries are not checked against the Reynolds "
                     "pressure: its reference cannot be built (reynoldsRef would stop): %s",
                     catcher.message);
+        reference_free(f);
         return;
     }
     t0 = lub_wtime() - t0;
@@ -209,10 +218,7 @@ static void check_reynolds(const lub_levels *L, const lub_case *c)
             }
         }
     }
-    free(f->p);
-    lub_refgap_free(&f->G);
-    lub_refcase_free(&f->rc);
-    free(f);
+    reference_free(f);
 }
 
 void lubfoam_check_levels(const lubfoam_run *r, const lub_geometry *geo)
