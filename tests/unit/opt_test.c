@@ -57,23 +57,31 @@ typedef struct {
     lub_opt o;
 } two_levels;
 
-/* The channel with the solver of mps_flow_test.c (Crank-Nicolson viscosity, weak
- * compressibility alpha l0^2 = 1e-6 on the fine level: the channel is closed) */
-static void setup_models(two_levels *t, double nu, double U, double force, const char *models)
+/* The solver of mps_flow_test.c (Crank-Nicolson viscosity, weak compressibility
+ * alpha l0^2 = 1e-6 on the fine level: the channels are closed), the patch "lower" sliding at
+ * U, a body force in x. */
+static lub_mps_config channel_config(const lub_particles *P, double nu, double U, double force)
 {
-    generate(channel, &t->P, &t->g);
-    read_levels(&t->L, models, &t->g);
     lub_mps_config c;
     lub_mps_config_defaults(&c);
     c.rho = 1000;
     c.nu = nu;
     c.viscosity = LUB_VISCOSITY_CN;
     c.alpha = 1e-6 / (1e-3 * 1e-3);
-    c.patch_velocity[lub_particles_find_patch(&t->P, "lower")][0] = U;
+    c.patch_velocity[lub_particles_find_patch(P, "lower")][0] = U;
     if (force != 0) {
         c.gravity = 1;
         c.g[0] = force;
     }
+    return c;
+}
+
+/* The channel with channel_config */
+static void setup_models(two_levels *t, double nu, double U, double force, const char *models)
+{
+    generate(channel, &t->P, &t->g);
+    read_levels(&t->L, models, &t->g);
+    lub_mps_config c = channel_config(&t->P, nu, U, force);
     lub_opt_init(&t->o, &t->L, &t->P, &c, &t->g, 0.0);
 }
 
@@ -492,17 +500,7 @@ static void setup3(two_levels *t, double nu, double U, double force, const char 
 {
     generate(channel3, &t->P, &t->g);
     read_levels(&t->L, models, &t->g);
-    lub_mps_config c;
-    lub_mps_config_defaults(&c);
-    c.rho = 1000;
-    c.nu = nu;
-    c.viscosity = LUB_VISCOSITY_CN;
-    c.alpha = 1e-6 / (1e-3 * 1e-3);
-    c.patch_velocity[lub_particles_find_patch(&t->P, "lower")][0] = U;
-    if (force != 0) {
-        c.gravity = 1;
-        c.g[0] = force;
-    }
+    lub_mps_config c = channel_config(&t->P, nu, U, force);
     lub_opt_init(&t->o, &t->L, &t->P, &c, &t->g, 0.5);
 }
 
@@ -811,12 +809,7 @@ static void test_surface_overlap(void)
     drop_disc(&t.P, 1, 0.026, 0.010, 0.0025);
     drop_disc(&t.P, 0, 0.032, 0.010, 0.0012);
     read_levels(&t.L, "multiResolution: { commonDeltaT: true }\n", &t.g);
-    lub_mps_config c;
-    lub_mps_config_defaults(&c);
-    c.rho = 1000;
-    c.nu = 1e-3;
-    c.viscosity = LUB_VISCOSITY_CN;
-    c.alpha = 1e-6 / (1e-3 * 1e-3);
+    lub_mps_config c = channel_config(&t.P, 1e-3, 0, 0);
     lub_opt_init(&t.o, &t.L, &t.P, &c, &t.g, 0.0);
     double dm;
     CHECK(run(&t, 1e-3, 1, 1, &dm) == 0);
