@@ -245,6 +245,44 @@ static void gs_sweep(lub_amg *g, lub_amg_level *lv, const double *b, double *x, 
     }
 }
 
+/* res = b - A x */
+static void residual(const lub_csr *A, const double *b, const double *x, double *res)
+{
+    const int n = A->n;
+    const int *rp = A->row_ptr, *col = A->col;
+    const double *val = A->val;
+#pragma omp parallel for schedule(static) if (n > LUB_LINALG_OMP_MIN)
+    for (int i = 0; i < n; i++) {
+        double s = b[i];
+        for (int k = rp[i]; k < rp[i + 1]; k++) s -= val[k] * x[col[k]];
+        res[i] = s;
+    }
+}
+
+/* The same residual right after the forward sweep from 0 (gs_sweep(.., 1, 1)), for half the
+ * work: that sweep made row i exact for the unknowns it saw, b_i = sum_{r0 <= j <= i} a_ij x_j
+ * (r0: the first row of i's block; the other blocks' unknowns were 0 to it), so
+ *     (b - A x)_i = - sum_{j > i} a_ij x_j - sum_{j < r0} a_ij x_j,
+ * the strict upper part of the row and its few columns in earlier blocks (columns are sorted,
+ * so those come first).  Equal to residual() to round-off (unit test). */
+static void residual_after_forward(const lub_amg *g, const lub_csr *A, const double *x, double *res)
+{
+    const int n = A->n;
+    const int nb = n > LUB_LINALG_OMP_MIN ? g->nblocks : 1;
+    const int *rp = A->row_ptr, *col = A->col, *diag = A->diag;
+    const double *val = A->val;
+#pragma omp parallel for schedule(static, 1) num_threads(nb) if (nb > 1)
+    for (int t = 0; t < nb; t++) {
+        const int r0 = (int)((long)n * t / nb), r1 = (int)((long)n * (t + 1) / nb);
+        for (int i = r0; i < r1; i++) {
+            double s = 0.0;
+            for (int k = rp[i]; k < diag[i] && col[k] < r0; k++) s -= val[k] * x[col[k]];
+            for (int k = diag[i] + 1; k < rp[i + 1]; k++) s -= val[k] * x[col[k]];
+            res[i] = s;
+        }
+    }
+}
+
 static void vcycle(lub_amg *g, int l, const double *b, double *x)
 {
     lub_amg_level *lv = &g->lev[l];
@@ -276,14 +314,10 @@ static void vcycle(lub_amg *g, int l, const double *b, double *x)
     gs_sweep(g, lv, b, x, 1, 1);
     /* restrict the residual: b_c = P^T (b - A x) */
     double *res = lv->tmp;
-    const int *rp = A->row_ptr, *col = A->col;
-    const double *val = A->val;
-#pragma omp parallel for schedule(static) if (n > LUB_LINALG_OMP_MIN)
-    for (int i = 0; i < n; i++) {
-        double s = b[i];
-        for (int k = rp[i]; k < rp[i + 1]; k++) s -= val[k] * x[col[k]];
-        res[i] = s;
-    }
+    if (g->unfused)
+        residual(A, b, x, res);
+    else
+        residual_after_forward(g, A, x, res);
     memset(c->b, 0, (size_t)lv->nc * sizeof *c->b);
     for (int i = 0; i < n; i++) c->b[agg[i]] += res[i];
     vcycle(g, l + 1, c->b, c->x);

@@ -48,6 +48,8 @@ typedef struct lub_amg {
     int coarse_max;      /* largest coarsest level for the dense Cholesky */
     int blocks;          /* smoother blocks: 0 = one per OpenMP thread */
     int nblocks;         /* used by the current set-up */
+    int unfused;         /* 1: the residual after pre-smoothing from its definition b - A x
+                          * (the test reference); 0 (default): from the upper triangle only */
     int nlev;
     lub_amg_level lev[LUB_AMG_MAX_LEVELS];
     /* coarsest level: dense Cholesky factor (lower, row-major), or GS sweeps when the

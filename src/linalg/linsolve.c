@@ -83,9 +83,11 @@ lub_solve_status lub_linsolver_solve(lub_linsolver *s, const lub_csr *A, int nrh
     }
     if (s->o.kind == LUB_LINSOLVER_CHOLMOD) return lub_cholmod_solve(s->chol, A, nrhs, b, x, res);
     lub_solve_status worst = LUB_SOLVE_OK;
-    for (int k = 0; k < nrhs; k++) {
-        lub_pcg_solve(&s->pcg, A, b[k], x[k], &s->o.pcg, &res[k]);
-        if (res[k].status > worst) worst = res[k].status;
+    for (int k0 = 0; k0 < nrhs; k0 += LUB_PCG_MAX_RHS) {
+        const int m = nrhs - k0 < LUB_PCG_MAX_RHS ? nrhs - k0 : LUB_PCG_MAX_RHS;
+        lub_pcg_solve_multi(&s->pcg, A, m, b + k0, x + k0, &s->o.pcg, res + k0);
     }
+    for (int k = 0; k < nrhs; k++)
+        if (res[k].status > worst) worst = res[k].status;
     return worst;
 }

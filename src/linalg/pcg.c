@@ -53,10 +53,11 @@ static void work_grow(lub_pcg_work *w, int n)
     if (n <= w->n_cap && w->r) return;
     int cap = n + n / 8 + 16;
     size_t sz = (size_t)cap * sizeof(double);
-    w->r = lub_realloc(w->r, sz);
-    w->z = lub_realloc(w->z, sz);
-    w->p = lub_realloc(w->p, sz);
-    w->q = lub_realloc(w->q, sz);
+    /* the CG vectors: one set per right-hand side of lub_pcg_solve_multi */
+    w->r = lub_realloc(w->r, LUB_PCG_MAX_RHS * sz);
+    w->z = lub_realloc(w->z, LUB_PCG_MAX_RHS * sz);
+    w->p = lub_realloc(w->p, LUB_PCG_MAX_RHS * sz);
+    w->q = lub_realloc(w->q, LUB_PCG_MAX_RHS * sz);
     w->dinv = lub_realloc(w->dinv, sz);
     w->l_ptr = lub_realloc(w->l_ptr, (size_t)(cap + 1) * sizeof(int));
     w->l_first = lub_realloc(w->l_first, (size_t)cap * sizeof(int));
@@ -316,21 +317,69 @@ static double dot(int n, const double *a, const double *b)
     return s;
 }
 
-/* q = A p, returns p.q */
-static double spmv_dot(const lub_csr *A, const double *p, double *q)
+/* q_k = A p_k for the m vectors (1 <= m <= LUB_PCG_MAX_RHS) in one pass over the matrix,
+ * pq[k] = p_k.q_k.  The matrix is read once for all of them: the sweep is bandwidth-bound, so
+ * m vectors cost much less than m products.  Each q_k and pq[k] is summed in the same order
+ * as with m = 1. */
+static void spmv_dot(const lub_csr *A, int m, double *const *p, double *const *q, double *pq)
 {
     const int n = A->n;
     const int *rp = A->row_ptr, *col = A->col;
     const double *val = A->val;
-    double s = 0.0;
-#pragma omp parallel for schedule(static) reduction(+ : s) if (n > LUB_LINALG_OMP_MIN)
-    for (int i = 0; i < n; i++) {
-        double t = 0.0;
-        for (int k = rp[i]; k < rp[i + 1]; k++) t += val[k] * p[col[k]];
-        q[i] = t;
-        s += p[i] * t;
+    if (m == 1) {
+        const double *p0 = p[0];
+        double *q0 = q[0], s0 = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : s0) if (n > LUB_LINALG_OMP_MIN)
+        for (int i = 0; i < n; i++) {
+            double t0 = 0.0;
+            for (int k = rp[i]; k < rp[i + 1]; k++) t0 += val[k] * p0[col[k]];
+            q0[i] = t0;
+            s0 += p0[i] * t0;
+        }
+        pq[0] = s0;
+    } else if (m == 2) {
+        const double *p0 = p[0], *p1 = p[1];
+        double *q0 = q[0], *q1 = q[1], s0 = 0.0, s1 = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : s0, s1) if (n > LUB_LINALG_OMP_MIN)
+        for (int i = 0; i < n; i++) {
+            double t0 = 0.0, t1 = 0.0;
+            for (int k = rp[i]; k < rp[i + 1]; k++) {
+                const double a = val[k];
+                const int j = col[k];
+                t0 += a * p0[j];
+                t1 += a * p1[j];
+            }
+            q0[i] = t0;
+            q1[i] = t1;
+            s0 += p0[i] * t0;
+            s1 += p1[i] * t1;
+        }
+        pq[0] = s0;
+        pq[1] = s1;
+    } else {
+        const double *p0 = p[0], *p1 = p[1], *p2 = p[2];
+        double *q0 = q[0], *q1 = q[1], *q2 = q[2], s0 = 0.0, s1 = 0.0, s2 = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : s0, s1, s2) if (n > LUB_LINALG_OMP_MIN)
+        for (int i = 0; i < n; i++) {
+            double t0 = 0.0, t1 = 0.0, t2 = 0.0;
+            for (int k = rp[i]; k < rp[i + 1]; k++) {
+                const double a = val[k];
+                const int j = col[k];
+                t0 += a * p0[j];
+                t1 += a * p1[j];
+                t2 += a * p2[j];
+            }
+            q0[i] = t0;
+            q1[i] = t1;
+            q2[i] = t2;
+            s0 += p0[i] * t0;
+            s1 += p1[i] * t1;
+            s2 += p2[i] * t2;
+        }
+        pq[0] = s0;
+        pq[1] = s1;
+        pq[2] = s2;
     }
-    return s;
 }
 
 /* r = b - A x, returns r.r */
@@ -401,7 +450,18 @@ static void finish(lub_solve_result *res, lub_solve_status st, int it, double re
 void lub_pcg_solve(lub_pcg_work *w, const lub_csr *A, const double *b, double *x,
                    const lub_pcg_options *o, lub_solve_result *res)
 {
+    lub_pcg_solve_multi(w, A, 1, &b, &x, o, res);
+}
+
+/* One CG per right-hand side, in lockstep: each has its own scalars and stops on its own
+ * (converged, breakdown, non-finite); the matrix products of the ones still running share
+ * one pass over A.  Per right-hand side the arithmetic is that of a solve of its own. */
+void lub_pcg_solve_multi(lub_pcg_work *w, const lub_csr *A, int nrhs, const double *const *b,
+                         double *const *x, const lub_pcg_options *o, lub_solve_result *res)
+{
     const int n = A->n;
+    if (nrhs < 1 || nrhs > LUB_PCG_MAX_RHS)
+        lub_bug("lub_pcg_solve_multi with %d right-hand sides (1 to %d)", nrhs, LUB_PCG_MAX_RHS);
     if (!(o->tolerance > 0 && isfinite(o->tolerance)) || o->max_iter < 0 ||
         (o->precond == LUB_PRECOND_SGS && !(o->omega > 0 && o->omega < 2)))
         lub_bug("bad PCG options: tolerance %g, max_iter %d, omega %g", o->tolerance, o->max_iter,
@@ -410,85 +470,114 @@ void lub_pcg_solve(lub_pcg_work *w, const lub_csr *A, const double *b, double *x
         (o->precond == LUB_PRECOND_SGS && w->omega != o->omega) ||
         (o->precond == LUB_PRECOND_BIC0 && w->blocks_opt != o->blocks))
         lub_pcg_setup(w, A, o);
-    memset(res, 0, sizeof *res);
-    res->column = -1;
-    res->ic_shift = w->ic_shift;
-
-    double *r = w->r, *z = w->z, *p = w->p, *q = w->q;
-    const double bnorm = sqrt(dot(n, b, b));
-    if (!isfinite(bnorm)) {
-        res->residual0 = NAN;
-        finish(res, LUB_SOLVE_NONFINITE, 0, NAN);
-        return;
-    }
-    if (bnorm == 0.0) {
-        /* the exact solution of A x = 0 */
-        memset(x, 0, (size_t)n * sizeof *x);
-        finish(res, LUB_SOLVE_OK, 0, 0.0);
-        return;
-    }
-    double rr;
-    if (o->warm_start) {
-        rr = residual(A, b, x, r);
-    } else {
-        memset(x, 0, (size_t)n * sizeof *x);
-        memcpy(r, b, (size_t)n * sizeof *r);
-        rr = bnorm * bnorm;
-    }
     const double tol = o->tolerance;
-    double rel = sqrt(rr) / bnorm;
-    res->residual0 = rel;
-    if (!isfinite(rel)) {
-        finish(res, LUB_SOLVE_NONFINITE, 0, rel);
-        return;
-    }
-    if (rel <= tol) {
-        finish(res, LUB_SOLVE_OK, 0, rel);
-        return;
+    double *r[LUB_PCG_MAX_RHS], *z[LUB_PCG_MAX_RHS], *p[LUB_PCG_MAX_RHS], *q[LUB_PCG_MAX_RHS];
+    double bnorm[LUB_PCG_MAX_RHS], rz[LUB_PCG_MAX_RHS], rr[LUB_PCG_MAX_RHS];
+    lub_solve_status st[LUB_PCG_MAX_RHS];
+    int act[LUB_PCG_MAX_RHS], na = 0;  /* the right-hand sides still iterating */
+    int inloop[LUB_PCG_MAX_RHS] = {0}; /* went into the iterations (not done at the start) */
+    for (int k = 0; k < nrhs; k++) {
+        const size_t off = (size_t)k * (size_t)w->n_cap;
+        r[k] = w->r + off, z[k] = w->z + off, p[k] = w->p + off, q[k] = w->q + off;
+        memset(&res[k], 0, sizeof res[k]);
+        res[k].column = -1;
+        res[k].ic_shift = w->ic_shift;
+        bnorm[k] = sqrt(dot(n, b[k], b[k]));
+        if (!isfinite(bnorm[k])) {
+            res[k].residual0 = NAN;
+            finish(&res[k], LUB_SOLVE_NONFINITE, 0, NAN);
+            continue;
+        }
+        if (bnorm[k] == 0.0) {
+            /* the exact solution of A x = 0 */
+            memset(x[k], 0, (size_t)n * sizeof *x[k]);
+            finish(&res[k], LUB_SOLVE_OK, 0, 0.0);
+            continue;
+        }
+        if (o->warm_start) {
+            rr[k] = residual(A, b[k], x[k], r[k]);
+        } else {
+            memset(x[k], 0, (size_t)n * sizeof *x[k]);
+            memcpy(r[k], b[k], (size_t)n * sizeof *r[k]);
+            rr[k] = bnorm[k] * bnorm[k];
+        }
+        const double rel = sqrt(rr[k]) / bnorm[k];
+        res[k].residual0 = rel;
+        if (!isfinite(rel)) {
+            finish(&res[k], LUB_SOLVE_NONFINITE, 0, rel);
+            continue;
+        }
+        if (rel <= tol) {
+            finish(&res[k], LUB_SOLVE_OK, 0, rel);
+            continue;
+        }
+        rz[k] = precond_dot(w, A, r[k], z[k]);
+        memcpy(p[k], z[k], (size_t)n * sizeof *p[k]);
+        st[k] = LUB_SOLVE_NOT_CONVERGED;
+        inloop[k] = 1;
+        act[na++] = k;
     }
 
-    double rz = precond_dot(w, A, r, z);
-    memcpy(p, z, (size_t)n * sizeof *p);
     int it = 0;
-    lub_solve_status st = LUB_SOLVE_NOT_CONVERGED;
-    while (it < o->max_iter) {
-        if (!(rz > 0)) {
-            st = isfinite(rz) ? LUB_SOLVE_BREAKDOWN : LUB_SOLVE_NONFINITE;
-            break;
-        }
-        double pq = spmv_dot(A, p, q);
-        if (!(pq > 0)) {
-            st = isfinite(pq) ? LUB_SOLVE_BREAKDOWN : LUB_SOLVE_NONFINITE;
-            break;
-        }
-        double alpha = rz / pq;
-        rr = update_xr(n, alpha, p, q, x, r);
-        it++;
-        if (!isfinite(rr)) {
-            st = LUB_SOLVE_NONFINITE;
-            break;
-        }
-        int restart = 0;
-        if (sqrt(rr) <= tol * bnorm) {
-            /* the recursive residual drifts from b - A x: decide on the true one */
-            rr = residual(A, b, x, r);
-            if (sqrt(rr) <= tol * bnorm) {
-                st = LUB_SOLVE_OK;
-                break;
+    double *pa[LUB_PCG_MAX_RHS], *qa[LUB_PCG_MAX_RHS], pq[LUB_PCG_MAX_RHS];
+    while (na > 0 && it < o->max_iter) {
+        /* a breakdown stops that right-hand side; the others go on */
+        int m = 0;
+        for (int a = 0; a < na; a++) {
+            const int k = act[a];
+            if (!(rz[k] > 0)) {
+                st[k] = isfinite(rz[k]) ? LUB_SOLVE_BREAKDOWN : LUB_SOLVE_NONFINITE;
+                res[k].iterations = it;
+                continue;
             }
-            restart = 1;
+            act[m++] = k;
         }
-        double rz_new = precond_dot(w, A, r, z);
-        if (restart) {
-            memcpy(p, z, (size_t)n * sizeof *p);
-        } else {
-            update_p(n, rz_new / rz, z, p);
+        na = m;
+        if (na == 0) break;
+        for (int a = 0; a < na; a++) pa[a] = p[act[a]], qa[a] = q[act[a]];
+        spmv_dot(A, na, pa, qa, pq);
+        it++;
+        m = 0;
+        for (int a = 0; a < na; a++) {
+            const int k = act[a];
+            if (!(pq[a] > 0)) {
+                st[k] = isfinite(pq[a]) ? LUB_SOLVE_BREAKDOWN : LUB_SOLVE_NONFINITE;
+                res[k].iterations = it - 1;
+                continue;
+            }
+            rr[k] = update_xr(n, rz[k] / pq[a], p[k], q[k], x[k], r[k]);
+            res[k].iterations = it;
+            if (!isfinite(rr[k])) {
+                st[k] = LUB_SOLVE_NONFINITE;
+                continue;
+            }
+            int restart = 0;
+            if (sqrt(rr[k]) <= tol * bnorm[k]) {
+                /* the recursive residual drifts from b - A x: decide on the true one */
+                rr[k] = residual(A, b[k], x[k], r[k]);
+                if (sqrt(rr[k]) <= tol * bnorm[k]) {
+                    st[k] = LUB_SOLVE_OK;
+                    continue;
+                }
+                restart = 1;
+            }
+            const double rz_new = precond_dot(w, A, r[k], z[k]);
+            if (restart) {
+                memcpy(p[k], z[k], (size_t)n * sizeof *p[k]);
+            } else {
+                update_p(n, rz_new / rz[k], z[k], p[k]);
+            }
+            rz[k] = rz_new;
+            act[m++] = k;
         }
-        rz = rz_new;
+        na = m;
     }
     /* the reported residual is always the true one */
-    if (st != LUB_SOLVE_OK) rr = residual(A, b, x, r);
-    rel = sqrt(rr) / bnorm;
-    if (st != LUB_SOLVE_OK && !isfinite(rel)) st = LUB_SOLVE_NONFINITE;
-    finish(res, st, it, rel);
+    for (int k = 0; k < nrhs; k++) {
+        if (!inloop[k]) continue;
+        if (st[k] != LUB_SOLVE_OK) rr[k] = residual(A, b[k], x[k], r[k]);
+        const double rel = sqrt(rr[k]) / bnorm[k];
+        if (st[k] != LUB_SOLVE_OK && !isfinite(rel)) st[k] = LUB_SOLVE_NONFINITE;
+        finish(&res[k], st[k], res[k].iterations, rel);
+    }
 }

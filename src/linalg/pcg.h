@@ -62,6 +62,8 @@ typedef enum {
 
 /* Most blocks of the block IC(0) (one per OpenMP thread). */
 #define LUB_PCG_MAX_BLOCKS 64
+/* lub_pcg_solve_multi: at most this many right-hand sides at once (a velocity per dimension) */
+#define LUB_PCG_MAX_RHS 3
 
 /* NULL-terminated, indexed by lub_precond: usable with lub_dict_choice (src/io/dict.h). */
 extern const char *const lub_precond_choice_names[];
@@ -80,7 +82,7 @@ lub_pcg_options lub_pcg_defaults(void);
 
 typedef struct lub_pcg_work {
     int n_cap, nnz_cap;
-    double *r, *z, *p, *q; /* CG vectors (n) */
+    double *r, *z, *p, *q; /* CG vectors: LUB_PCG_MAX_RHS sets of n_cap each */
     double *dinv;          /* 1 / a_ii (jacobi, sgs) or 1 / L_ii (ic0) */
     /* IC(0) factor: strictly lower part of L in CSR (own copy of the lower pattern of A) */
     int *l_ptr, *l_col;
@@ -112,6 +114,13 @@ double lub_pcg_setup(lub_pcg_work *w, const lub_csr *A, const lub_pcg_options *o
  * (tolerance <= 0 or not finite, max_iter < 0, omega outside (0, 2)) is a bug of the caller. */
 void lub_pcg_solve(lub_pcg_work *w, const lub_csr *A, const double *b, double *x,
                    const lub_pcg_options *o, lub_solve_result *res);
+
+/* Solve A x_k = b_k for nrhs (1 to LUB_PCG_MAX_RHS) right-hand sides: one CG each, with the
+ * same results as nrhs calls of lub_pcg_solve (to round-off of the parallel sums; exactly on
+ * one thread), but with their matrix products fused into one pass over A.  res[k] per
+ * right-hand side. */
+void lub_pcg_solve_multi(lub_pcg_work *w, const lub_csr *A, int nrhs, const double *const *b,
+                         double *const *x, const lub_pcg_options *o, lub_solve_result *res);
 
 /* Apply the preconditioner set up in w: z = M^-1 r (exposed for tests). */
 void lub_pcg_precond_apply(lub_pcg_work *w, const lub_csr *A, const double *r, double *z);

@@ -675,6 +675,49 @@ static void mps_lattice(lub_csr *A, int nx, int ny)
     lub_csr_finish(A);
 }
 
+/* The V-cycle's residual after the forward sweep from 0, taken from the upper triangle (and
+ * the columns in earlier smoother blocks), equals b - A x from its definition to round-off:
+ * the whole V-cycle gives the same z both ways, with one block (plain Gauss-Seidel) and with
+ * 2 and 3 blocks (hybrid), on the MPS-like matrix (5,000 unknowns: above LUB_LINALG_OMP_MIN,
+ * so the finest level is smoothed in blocks). */
+static void test_amg_fused_residual(void)
+{
+    lub_csr A;
+    lub_csr_init(&A);
+    mps_lattice(&A, 100, 50);
+    const int n = A.n;
+    CHECK(n > LUB_LINALG_OMP_MIN);
+    double *r = malloc(n * sizeof *r), *z0 = malloc(n * sizeof *z0), *z1 = malloc(n * sizeof *z1);
+    for (int i = 0; i < n; i++) r[i] = rnd() - 0.5;
+    for (int blocks = 1; blocks <= 3; blocks++) {
+        lub_pcg_work w;
+        lub_pcg_work_init(&w);
+        w.amg.blocks = blocks;
+        lub_pcg_options o = lub_pcg_defaults();
+        o.precond = LUB_PRECOND_AMG;
+        lub_pcg_setup(&w, &A, &o);
+        CHECK(w.amg.nblocks == blocks && w.amg.nlev >= 3);
+        w.amg.unfused = 1;
+        lub_pcg_precond_apply(&w, &A, r, z0);
+        w.amg.unfused = 0;
+        lub_pcg_precond_apply(&w, &A, r, z1);
+        double d = 0, zmax = 0;
+        for (int i = 0; i < n; i++) {
+            d = fmax(d, fabs(z1[i] - z0[i]));
+            zmax = fmax(zmax, fabs(z0[i]));
+        }
+        CHECK(zmax > 0);
+        CHECK(d <= 1e-12 * zmax);
+        printf("  fused residual, %d block(s): largest difference %.2e of max |z| %.3g\n", blocks,
+               d, zmax);
+        lub_pcg_work_free(&w);
+    }
+    free(r);
+    free(z0);
+    free(z1);
+    lub_csr_free(&A);
+}
+
 /* On the MPS-like matrix every preconditioner and CHOLMOD give the same solution (CHOLMOD's,
  * backward stable, as the reference: both within kappa * residual of the truth), and the
  * iteration counts are ordered amg < ic0 < jacobi. */
@@ -959,6 +1002,116 @@ static void test_multiple_rhs(void)
     lub_csr_free(&A);
 }
 
+/* lub_pcg_solve_multi: each right-hand side is the CG it would be alone.  On the 2-D Poisson
+ * matrix (72 x 72: above LUB_LINALG_OMP_MIN, so the loops are parallel) with Jacobi and AMG:
+ * three right-hand sides needing different iteration counts (a smooth one, a rough one, and
+ * a warm start near the solution) give the solutions and iteration counts of three
+ * single solves (1e-13: the parallel sums may add in another order); a zero and a non-finite
+ * right-hand side stop at once (x = 0, LUB_SOLVE_NONFINITE) while the third one converges as
+ * alone; max_iter stops all of them with the true residual; and lub_linsolver_solve with five
+ * right-hand sides (3 + 2) gives the single solves' answers. */
+static void test_pcg_multi(void)
+{
+    const int m = 72, n = m * m;
+    CHECK(n > LUB_LINALG_OMP_MIN);
+    lub_csr A;
+    lub_csr_init(&A);
+    poisson2d(&A, m);
+    double *xe[5], *b[5], *x[5], *x1 = malloc(n * sizeof *x1);
+    for (int k = 0; k < 5; k++) {
+        xe[k] = malloc(n * sizeof(double));
+        b[k] = malloc(n * sizeof(double));
+        x[k] = malloc(n * sizeof(double));
+        manufactured(n, xe[k], 3 + 7 * k);
+    }
+    for (int i = 0; i < n; i++) xe[1][i] = rnd() - 0.5; /* rough: more iterations */
+    for (int k = 0; k < 5; k++) apply2d(m, xe[k], b[k]);
+    const lub_precond pcs[2] = {LUB_PRECOND_JACOBI, LUB_PRECOND_AMG};
+    for (int t = 0; t < 2; t++) {
+        lub_pcg_options o = lub_pcg_defaults();
+        o.precond = pcs[t];
+        o.tolerance = 1e-9;
+        o.warm_start = 1;
+        o.max_iter = 5000;
+        lub_pcg_work w;
+        lub_pcg_work_init(&w);
+        /* initial guesses: 0, 0, and the solution disturbed by 1e-6 */
+        for (int i = 0; i < n; i++)
+            x[0][i] = x[1][i] = 0.0, x[2][i] = xe[2][i] * (1 + 1e-6 * rnd());
+        double *x2 = malloc(n * sizeof *x2);
+        memcpy(x2, x[2], n * sizeof *x2);
+        lub_solve_result r[3], r1;
+        lub_pcg_solve_multi(&w, &A, 3, (const double *const *)b, x, &o, r);
+        int it[3];
+        for (int k = 0; k < 3; k++) {
+            memcpy(x1, k == 2 ? x2 : x[k], n * sizeof *x1);
+            if (k < 2) memset(x1, 0, n * sizeof *x1);
+            lub_pcg_solve(&w, &A, b[k], x1, &o, &r1);
+            CHECK(r[k].converged && r1.converged);
+            CHECK(r[k].iterations == r1.iterations);
+            CHECK_NEAR(r[k].residual, r1.residual, 1e-13 * r1.residual + 1e-300);
+            CHECK(rel_err(n, x[k], x1) <= 1e-13);
+            CHECK(r[k].residual <= 1e-9);
+            CHECK(rel_err(n, x[k], xe[k]) <= kappa2d(m) * r[k].residual);
+            it[k] = r[k].iterations;
+        }
+        /* they did stop at different iterations: the warm start one first */
+        CHECK(it[2] < it[0] && it[2] < it[1]);
+        printf("  %s, 3 right-hand sides: %d, %d, %d iterations, as alone\n", t ? "amg" : "jacobi",
+               it[0], it[1], it[2]);
+        /* a zero and a non-finite right-hand side beside a normal one */
+        double *bz = calloc(n, sizeof *bz), *bn = malloc(n * sizeof *bn);
+        memcpy(bn, b[0], n * sizeof *bn);
+        bn[n / 2] = NAN;
+        const double *bb[3] = {bz, bn, b[0]};
+        for (int k = 0; k < 3; k++)
+            for (int i = 0; i < n; i++) x[k][i] = 1.0;
+        for (int i = 0; i < n; i++) x[2][i] = 0.0;
+        lub_pcg_solve_multi(&w, &A, 3, bb, x, &o, r);
+        CHECK(r[0].status == LUB_SOLVE_OK && r[0].iterations == 0 && x[0][n - 1] == 0.0);
+        CHECK(r[1].status == LUB_SOLVE_NONFINITE && r[1].iterations == 0);
+        CHECK(r[2].converged && r[2].iterations == it[0]);
+        /* max_iter: all three stop there, not converged, with the true residual */
+        o.max_iter = 3;
+        for (int k = 0; k < 3; k++) memset(x[k], 0, n * sizeof *x[k]);
+        lub_pcg_solve_multi(&w, &A, 3, (const double *const *)b, x, &o, r);
+        for (int k = 0; k < 3; k++) {
+            CHECK(r[k].status == LUB_SOLVE_NOT_CONVERGED && r[k].iterations == 3);
+            CHECK_NEAR(r[k].residual, rel_res(n, apply2d, m, b[k], x[k]), 1e-10);
+        }
+        free(bz);
+        free(bn);
+        free(x2);
+        lub_pcg_work_free(&w);
+    }
+    /* five right-hand sides through lub_linsolver_solve: two fused calls */
+    lub_linsolver_options lo = lub_linsolver_defaults();
+    lo.kind = LUB_LINSOLVER_PCG;
+    lo.pcg.precond = LUB_PRECOND_JACOBI;
+    lo.pcg.tolerance = 1e-9;
+    lub_linsolver s;
+    lub_linsolver_init(&s, &lo);
+    lub_solve_result r5[5], r1;
+    for (int k = 0; k < 5; k++) memset(x[k], 0, n * sizeof *x[k]);
+    CHECK(lub_linsolver_solve(&s, &A, 5, (const double *const *)b, x, r5) == LUB_SOLVE_OK);
+    for (int k = 0; k < 5; k++) {
+        const double *bk[1] = {b[k]};
+        double *xk[1] = {x1};
+        memset(x1, 0, n * sizeof *x1);
+        lub_linsolver_solve(&s, &A, 1, bk, xk, &r1);
+        CHECK(r5[k].converged && r5[k].iterations == r1.iterations);
+        CHECK(rel_err(n, x[k], x1) <= 1e-13);
+    }
+    lub_linsolver_free(&s);
+    for (int k = 0; k < 5; k++) {
+        free(xe[k]);
+        free(b[k]);
+        free(x[k]);
+    }
+    free(x1);
+    lub_csr_free(&A);
+}
+
 int main(void)
 {
     RUN(test_csr_random_pattern_matches_dense);
@@ -972,6 +1125,7 @@ int main(void)
     RUN(test_pcg_special_cases);
     RUN(test_ic0_shift_on_breakdown);
     RUN(test_amg_preconditioner);
+    RUN(test_amg_fused_residual);
     RUN(test_pcg_work_reuse_across_sizes);
     RUN(test_mps_like_matrix_all_solvers);
     RUN(test_cholmod_poisson);
@@ -979,6 +1133,7 @@ int main(void)
     RUN(test_cholmod_reanalyse_on_pattern_change);
     RUN(test_linsolver_names);
     RUN(test_multiple_rhs);
+    RUN(test_pcg_multi);
     /* release the OpenMP thread pool (ours and the one CHOLMOD's supernodal factorisation
      * starts with its compiled-in 4 threads), whose thread stacks valgrind would otherwise
      * list as possibly lost */

@@ -81,6 +81,12 @@ static const char *description =
     "      uses the elasticWall h0 and the circle: v = 0.  -dimensionless adds X = x/b and\n"
     "      H = h R/b^2 (T-54..T-58); -average the mean per particle over the times.\n"
     "      Multi-resolution: the wall particles in the part of x their level owns.\n"
+    "  front\n"
+    "      the surge front of a collapsing column (dam break, flowing towards +x over a\n"
+    "      floor), per time: '# t xFront yTop fluidParticles'.  xFront: the largest x of the\n"
+    "      fluid particles in the two lowest particle rows (less than 1.5 l0 above the lowest\n"
+    "      fluid particle), plus l0/2, the edge of its cell: at t = 0 the face of the column;\n"
+    "      yTop: the highest fluid particle plus l0/2 (y is the vertical in 2-D, z in 3-D).\n"
     "\n"
     "Fields (-field, comma-separated): p, U (columns Ux Uy [Uz]), Ux, Uy, Uz, and the\n"
     "optional fields of the particle files (pMean, pnd ...); default p.\n"
@@ -107,8 +113,9 @@ static const char *description =
     "subcommand) and the options as keys: patch, field (name, 'p,U' or [p, U]), from, to, bin,\n"
     "arc, at ([[x, y], ...]), average ([T0, T1]), dimensionless.  'probe' runs every set and\n"
     "'probe -set NAME' one (repeatable); each writes postProcessing/probe/<time>/<NAME>.dat per\n"
-    "time folder (averaged: under the window's last time; totals: one table under the first\n"
-    "time), or with -o FILE (one set) that file.  -average and -dimensionless on the command\n"
+    "time folder (averaged: under the window's last time; totals, front: one table under the\n"
+    "first time), or with -o FILE (one set) that file.  -average and -dimensionless on the "
+    "command\n"
     "line override the sets'.  Template: etc/templates/probeDict.yaml.\n"
     "\n"
     "Examples:\n"
@@ -120,6 +127,7 @@ static const char *description =
     "  probe totals -o totals.dat\n"
     "  probe totals -patch cylinder              (load history of the elastic wall)\n"
     "  probe wallShape -patch cylinder -latestTime -dimensionless\n"
+    "  probe front -o postProcessing/probe/front.dat   (dam break: surge front against t)\n"
     "  probe -set pWall -latestTime\n"
     "\n"
     "Errors (exit 1): an unknown subcommand, patch (the patches are listed) or field (the\n"
@@ -135,6 +143,7 @@ static const int applies[PROBE_NKINDS][O_N] = {
     [PROBE_WALL] = {1, 1, 1, 1, 1, 1, 0, 1},   [PROBE_LINE] = {0, 1, 1, 1, 1, 0, 0, 1},
     [PROBE_POINTS] = {0, 1, 0, 0, 0, 0, 1, 1}, [PROBE_FILM] = {0, 0, 1, 1, 1, 0, 0, 1},
     [PROBE_TOTALS] = {1, 0, 0, 0, 0, 0, 0, 0}, [PROBE_SHAPE] = {1, 0, 1, 1, 0, 0, 0, 1},
+    [PROBE_FRONT] = {0, 0, 0, 0, 0, 0, 0, 0},
 };
 
 static const char *in_case(const lub_case *c, const char *path, char *buf)
@@ -151,7 +160,8 @@ static probe_kind find_kind(const char *name)
     char hint[64] = "";
     if (near) snprintf(hint, sizeof hint, " (did you mean '%s'?)", near);
     lub_fatal("unknown subcommand '%s'%s; the subcommands are: wallPressure line points film "
-              "totals wallShape (or none: the sets of system/probeDict.yaml); see probe -help",
+              "totals wallShape front (or none: the sets of system/probeDict.yaml); see probe "
+              "-help",
               name, hint);
 }
 
@@ -272,7 +282,8 @@ int main(int argc, char **argv)
         for (int i = 0; i < S.n; i++) {
             if (!run[i]) continue;
             probe_spec *s = &S.sets[i];
-            if (dimensionless && s->kind != PROBE_TOTALS) s->dimensionless = 1;
+            if (dimensionless && s->kind != PROBE_TOTALS && s->kind != PROBE_FRONT)
+                s->dimensionless = 1;
             if (average) s->average = 1, s->t0 = t0, s->t1 = t1, s->average_node = NULL;
             probe_sink k;
             probe_sink_init(&k, &x.c, opath, out == NULL, s->name);

@@ -26,6 +26,7 @@ typedef enum {
     PROBE_FILM,
     PROBE_TOTALS,
     PROBE_SHAPE,
+    PROBE_FRONT,
     PROBE_NKINDS
 } probe_kind;
 

@@ -19,7 +19,7 @@
 #include "probe.h"
 
 const char *const probe_kind_names[] = {"wallPressure", "line",      "points", "film",
-                                        "totals",       "wallShape", NULL};
+                                        "totals",       "wallShape", "front",  NULL};
 
 void probe_spec_init(probe_spec *s, probe_kind kind, const char *name)
 {
@@ -224,7 +224,8 @@ static void read_set(probe_spec *s, const char *name, lub_node *m)
         s->t1 = w[1];
         s->average_node = av;
     }
-    if (kind != PROBE_TOTALS) s->dimensionless = lub_dict_bool_or(m, "dimensionless", 0);
+    if (kind != PROBE_TOTALS && kind != PROBE_FRONT)
+        s->dimensionless = lub_dict_bool_or(m, "dimensionless", 0);
 }
 
 void probe_sets_read(probe_sets *S, const lub_case *c)

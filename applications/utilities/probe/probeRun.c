@@ -995,6 +995,65 @@ static void run_totals(job *j)
     probe_sink_write(j->k, &j->b, j->times[0].name, j->times[0].value);
 }
 
+/* ---- front: the surge front of a dam break, one row per time ------------------------- */
+
+static void run_front(job *j)
+{
+    enum { NC = 4 };
+    double sum[NC] = {0};
+    for (size_t it = 0; it < j->nt; it++) {
+        job_read(j, it);
+        const lub_particles *P = &j->P;
+        const int v = P->dim - 1; /* the vertical: y in 2-D, z in 3-D */
+        /* the lowest fluid particle, then the front of the two lowest rows above it, each
+         * particle with the l0 of its level */
+        double vmin = INFINITY;
+        size_t nf = 0;
+        for (size_t i = 0; i < P->n; i++)
+            if (P->kind[i] == LUB_FLUID) {
+                vmin = fmin(vmin, P->x[v][i]);
+                nf++;
+            }
+        double xf = -INFINITY, top = -INFINITY;
+        for (size_t i = 0; i < P->n; i++) {
+            if (P->kind[i] != LUB_FLUID) continue;
+            const double l0 = P->levels[P->level[i]].l0;
+            if (P->x[v][i] < vmin + 1.5 * l0) xf = fmax(xf, P->x[0][i] + 0.5 * l0);
+            top = fmax(top, P->x[v][i] + 0.5 * l0);
+        }
+        if (nf == 0) {
+            lub_warning("%s has no fluid particle: its front is not a number", j->file);
+            xf = top = NAN;
+        }
+        const double row[NC] = {j->times[it].value, xf, top, (double)nf};
+        if (it == 0) {
+            probe_block_begin(&j->b,
+                              P->dim == 2 ? "t[s] xFront[m] yTop[m] fluidParticles"
+                                          : "t[s] xFront[m] zTop[m] fluidParticles",
+                              NC);
+            probe_block_comment(&j->b,
+                                "xFront: the largest x of the fluid particles less than 1.5 l0 "
+                                "above the lowest one, + l0/2; %cTop: the highest, + l0/2",
+                                P->dim == 2 ? 'y' : 'z');
+        }
+        lub_particles_free(&j->P);
+        if (j->s->average)
+            for (int c = 0; c < NC; c++) sum[c] += row[c];
+        else
+            probe_block_row(&j->b, row);
+    }
+    if (j->s->average) {
+        for (int c = 0; c < NC; c++) sum[c] /= (double)j->nt;
+        probe_block_row(&j->b, sum);
+        probe_block_comment(&j->b, "mean over the %zu time folders %s .. %s", j->nt,
+                            j->times[0].name, j->times[j->nt - 1].name);
+        job_emit(j, j->nt - 1);
+        return;
+    }
+    /* one table of all times, under the first time (as totals) */
+    probe_sink_write(j->k, &j->b, j->times[0].name, j->times[0].value);
+}
+
 /* ---- entry ---------------------------------------------------------------------------- */
 
 void probe_run(probe_ctx *x, probe_spec *s, probe_sink *k)
@@ -1004,10 +1063,11 @@ void probe_run(probe_ctx *x, probe_spec *s, probe_sink *k)
     j.x = x;
     j.s = s;
     j.k = k;
-    if (s->dimensionless && s->kind == PROBE_TOTALS)
-        probe_error(s->node, "-dimensionless does not apply to totals");
+    if (s->dimensionless && (s->kind == PROBE_TOTALS || s->kind == PROBE_FRONT))
+        probe_error(s->node, "-dimensionless does not apply to %s", probe_kind_names[s->kind]);
     job_times(&j);
-    k->tcol = !k->per_time && j.nt > 1 && !s->average && s->kind != PROBE_TOTALS;
+    k->tcol = !k->per_time && j.nt > 1 && !s->average && s->kind != PROBE_TOTALS &&
+              s->kind != PROBE_FRONT;
     if (s->dimensionless) j.sc = ctx_scales(x);
     switch (s->kind) {
     case PROBE_WALL:
@@ -1030,6 +1090,9 @@ void probe_run(probe_ctx *x, probe_spec *s, probe_sink *k)
         break;
     case PROBE_SHAPE:
         run_shape(&j);
+        break;
+    case PROBE_FRONT:
+        run_front(&j);
         break;
     default:
         lub_bug("kind %d", (int)s->kind);
