@@ -1044,8 +1044,10 @@ static void test_pcg_multi(void)
         lub_pcg_solve_multi(&w, &A, 3, (const double *const *)b, x, &o, r);
         int it[3];
         for (int k = 0; k < 3; k++) {
-            memcpy(x1, k == 2 ? x2 : x[k], n * sizeof *x1);
-            if (k < 2) memset(x1, 0, n * sizeof *x1);
+            if (k == 2)
+                memcpy(x1, x2, n * sizeof *x1);
+            else
+                memset(x1, 0, n * sizeof *x1);
             lub_pcg_solve(&w, &A, b[k], x1, &o, &r1);
             CHECK(r[k].converged && r1.converged);
             CHECK(r[k].iterations == r1.iterations);

@@ -845,6 +845,31 @@ static void run_shape(job *j)
     lub_accum_free(&acc);
 }
 
+/* ---- time series (totals, front): one row per time, or their mean with -average -------- */
+
+static void series_row(job *j, const double *row, double *sum, int nc)
+{
+    if (j->s->average)
+        for (int c = 0; c < nc; c++) sum[c] += row[c];
+    else
+        probe_block_row(&j->b, row);
+}
+
+/* Write the series: the mean row under the window's last time with -average, else one table
+ * of all times under the first time, like the function objects' time series. */
+static void series_emit(job *j, double *sum, int nc)
+{
+    if (j->s->average) {
+        for (int c = 0; c < nc; c++) sum[c] /= (double)j->nt;
+        probe_block_row(&j->b, sum);
+        probe_block_comment(&j->b, "mean over the %zu time folders %s .. %s", j->nt,
+                            j->times[0].name, j->times[j->nt - 1].name);
+        job_emit(j, j->nt - 1);
+        return;
+    }
+    probe_sink_write(j->k, &j->b, j->times[0].name, j->times[0].value);
+}
+
 /* ---- totals: one row per time --------------------------------------------------------- */
 
 /* Multi-resolution totals (T-27): each fluid particle with the particle mass of its level
@@ -977,22 +1002,9 @@ static void run_totals(job *j)
                                     mass0_from);
             }
         }
-        if (j->s->average)
-            for (int c = 0; c < nc; c++) sum[c] += row[c];
-        else
-            probe_block_row(&j->b, row);
+        series_row(j, row, sum, nc);
     }
-    if (j->s->average) {
-        for (int c = 0; c < nc; c++) sum[c] /= (double)j->nt;
-        probe_block_row(&j->b, sum);
-        probe_block_comment(&j->b, "mean over the %zu time folders %s .. %s", j->nt,
-                            j->times[0].name, j->times[j->nt - 1].name);
-        job_emit(j, j->nt - 1);
-        return;
-    }
-    /* one table of all times: in postProcessing under the first time, like the function
-     * objects' time series */
-    probe_sink_write(j->k, &j->b, j->times[0].name, j->times[0].value);
+    series_emit(j, sum, nc);
 }
 
 /* ---- front: the surge front of a dam break, one row per time ------------------------- */
@@ -1037,21 +1049,9 @@ static void run_front(job *j)
                                 P->dim == 2 ? 'y' : 'z');
         }
         lub_particles_free(&j->P);
-        if (j->s->average)
-            for (int c = 0; c < NC; c++) sum[c] += row[c];
-        else
-            probe_block_row(&j->b, row);
+        series_row(j, row, sum, NC);
     }
-    if (j->s->average) {
-        for (int c = 0; c < NC; c++) sum[c] /= (double)j->nt;
-        probe_block_row(&j->b, sum);
-        probe_block_comment(&j->b, "mean over the %zu time folders %s .. %s", j->nt,
-                            j->times[0].name, j->times[j->nt - 1].name);
-        job_emit(j, j->nt - 1);
-        return;
-    }
-    /* one table of all times, under the first time (as totals) */
-    probe_sink_write(j->k, &j->b, j->times[0].name, j->times[0].value);
+    series_emit(j, sum, NC);
 }
 
 /* ---- entry ---------------------------------------------------------------------------- */
