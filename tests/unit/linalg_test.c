@@ -64,6 +64,69 @@ static void csr_from_dense(lub_csr *A, int n, const double *D)
     lub_csr_finish(A);
 }
 
+/* lub_csr_finish sorts each row with its values: rows of interleaved ascending runs (as
+ * assembled from neighbour lists in cell order), reversed, shuffled and sorted rows, and
+ * rows longer than the merge buffer (sorted by insertion).  Value of (i, j): i + j / 1000. */
+static void test_csr_sort_rows(void)
+{
+    const int n = 600;
+    lub_csr A;
+    lub_csr_init(&A);
+    lub_csr_begin(&A, n);
+    for (int i = 0; i < n; i++) lub_csr_set_row_length(&A, i, i < 3 ? n : 1 + i % 60);
+    lub_csr_alloc(&A);
+    for (int i = 0; i < n; i++) {
+        int *c = lub_csr_row_col(&A, i);
+        double *v = lub_csr_row_val(&A, i);
+        const int len = lub_csr_row_length(&A, i);
+        /* the columns: the diagonal and the len - 1 columns after it (cyclic) */
+        for (int k = 0; k < len; k++) c[k] = (i + k) % n;
+        switch (i % 4) {
+        case 0: { /* r ascending runs interleaved: every r-th column in turn */
+            const int r = 1 + i % 9;
+            int *t = malloc((size_t)len * sizeof *t), m = 0;
+            for (int q = 0; q < r; q++)
+                for (int k = q; k < len; k += r) t[m++] = c[k];
+            for (int k = 0; k < len; k++) c[k] = t[k];
+            free(t);
+            break;
+        }
+        case 1: /* reversed */
+            for (int k = 0; k < len / 2; k++) {
+                int t = c[k];
+                c[k] = c[len - 1 - k];
+                c[len - 1 - k] = t;
+            }
+            break;
+        case 2: /* shuffled */
+            for (int k = len - 1; k > 0; k--) {
+                int m = (int)(rnd() * (k + 1)), t = c[k];
+                c[k] = c[m];
+                c[m] = t;
+            }
+            break;
+        default: /* as generated: sorted except for the cyclic wrap */
+            break;
+        }
+        for (int k = 0; k < len; k++) v[k] = i + c[k] / 1000.0;
+    }
+    lub_csr_finish(&A);
+    int ok_sorted = 1, ok_val = 1, ok_diag = 1, ok_len = 1;
+    for (int i = 0; i < n; i++) {
+        if (lub_csr_row_length(&A, i) != (i < 3 ? n : 1 + i % 60)) ok_len = 0;
+        for (int k = A.row_ptr[i]; k < A.row_ptr[i + 1]; k++) {
+            if (k > A.row_ptr[i] && A.col[k] <= A.col[k - 1]) ok_sorted = 0;
+            if (A.val[k] != i + A.col[k] / 1000.0) ok_val = 0;
+        }
+        if (A.col[A.diag[i]] != i) ok_diag = 0;
+    }
+    CHECK(ok_len);
+    CHECK(ok_sorted);
+    CHECK(ok_val);
+    CHECK(ok_diag);
+    lub_csr_free(&A);
+}
+
 /* 1-D Poisson, n interior points, Dirichlet ends: tridiag(-1, 2, -1). */
 static void poisson1d(lub_csr *A, int n)
 {
@@ -1117,6 +1180,7 @@ static void test_pcg_multi(void)
 int main(void)
 {
     RUN(test_csr_random_pattern_matches_dense);
+    RUN(test_csr_sort_rows);
     RUN(test_pcg_poisson1d_each_preconditioner);
     RUN(test_pcg_poisson2d_each_preconditioner);
     RUN(test_ic0_exact_on_tridiagonal);
