@@ -144,6 +144,37 @@ static void print_header(const lubfoam_run *r)
                 : m->c.viscosity == LUB_VISCOSITY_EXPLICIT ? "explicit"
                                                            : "crankNicolson");
     lub_message("Solvers: p %s; U %s", ps, vs);
+    /* the models of constant/models.yaml this run has (a scene enables only those it needs) */
+    char models[1024];
+    size_t len = 0;
+#define LUB_MODELS_ADD(...)                                                                        \
+    do {                                                                                           \
+        if (len < sizeof models)                                                                   \
+            len += (size_t)snprintf(models + len, sizeof models - len, __VA_ARGS__);               \
+    } while (0)
+    models[0] = '\0';
+    if (m->c.gravity) {
+        LUB_MODELS_ADD("gravity (%g", m->c.g[0]);
+        for (int d = 1; d < m->dim; d++) LUB_MODELS_ADD(", %g", m->c.g[d]);
+        LUB_MODELS_ADD(") m/s^2");
+    }
+    int moving = 0;
+    for (int k = 0; k < m->P->npatches && k < LUB_MAX_PATCHES; k++) {
+        const double *v = m->c.patch_velocity[k];
+        if (v[0] == 0 && v[1] == 0 && v[2] == 0) continue;
+        LUB_MODELS_ADD("%s%s", len ? (moving ? ", " : "; ") : "", moving ? "" : "movingWalls ");
+        LUB_MODELS_ADD("%s (%g", m->P->patch_names[k], v[0]);
+        for (int d = 1; d < m->dim; d++) LUB_MODELS_ADD(", %g", v[d]);
+        LUB_MODELS_ADD(") m/s");
+        moving++;
+    }
+    if (m->c.collision)
+        LUB_MODELS_ADD("%scollision (distance %g l0, restitution %g)", len ? "; " : "",
+                       m->c.collision_distance, m->c.restitution);
+    if (r->has_elastic) LUB_MODELS_ADD("%selasticWall", len ? "; " : "");
+    if (r->opt) LUB_MODELS_ADD("%smultiResolution", len ? "; " : "");
+#undef LUB_MODELS_ADD
+    lub_message("Models: %s", len ? models : "none (constant/models.yaml)");
     if (r->has_elastic) {
         const lub_mps_elastic *w = &r->elastic;
         lub_message("elasticWall: patch %s (%d wall, %d dummy particles), E %g Pa, load %g N/m "
