@@ -25,10 +25,10 @@ void lub_amg_free(lub_amg *g)
         free(g->lev[l].b);
         free(g->lev[l].x);
         free(g->lev[l].tmp);
+        free(g->lev[l].mstart);
+        free(g->lev[l].mrows);
     }
     free(g->dense);
-    free(g->cnt);
-    free(g->rows);
     free(g->mark);
     memset(g, 0, sizeof *g);
 }
@@ -80,54 +80,75 @@ static int aggregate(const lub_csr *A, double theta, int *agg)
     return nc;
 }
 
-/* C = P^T A P for the piecewise-constant P of agg: C_IJ = sum_{i in I, j in J} a_ij. */
-static void galerkin(lub_amg *g, const lub_csr *A, const int *agg, int nc, lub_csr *C)
+/* The members of each aggregate in increasing order (a counting sort of agg): the rows the
+ * Galerkin product sums and the restriction gathers. */
+static void members(lub_amg_level *lv, int n)
 {
-    const int n = A->n;
-    grow_int(&g->cnt, &g->cnt_cap, nc + 1);
-    grow_int(&g->rows, &g->rows_cap, n);
-    grow_int(&g->mark, &g->mark_cap, 2 * nc);
-    int *cnt = g->cnt, *rows = g->rows, *mark = g->mark, *pos = g->mark + nc;
-    /* the fine rows of each aggregate, in CSR form */
-    memset(cnt, 0, (size_t)(nc + 1) * sizeof *cnt);
-    for (int i = 0; i < n; i++) cnt[agg[i] + 1]++;
-    for (int I = 0; I < nc; I++) cnt[I + 1] += cnt[I];
-    memcpy(pos, cnt, (size_t)nc * sizeof *pos);
-    for (int i = 0; i < n; i++) rows[pos[agg[i]]++] = i;
+    const int nc = lv->nc;
+    grow_int(&lv->mstart, &lv->mstart_cap, nc + 1);
+    grow_int(&lv->mrows, &lv->mrows_cap, n);
+    int *ms = lv->mstart, *mr = lv->mrows;
+    memset(ms, 0, (size_t)(nc + 1) * sizeof *ms);
+    for (int i = 0; i < n; i++) ms[lv->agg[i] + 1]++;
+    for (int I = 0; I < nc; I++) ms[I + 1] += ms[I];
+    for (int i = 0; i < n; i++) mr[ms[lv->agg[i]]++] = i;
+    for (int I = nc; I > 0; I--) ms[I] = ms[I - 1]; /* the fill advanced each start to the next */
+    ms[0] = 0;
+}
+
+/* C = P^T A P for the piecewise-constant P of agg: C_IJ = sum_{i in I, j in J} a_ij, one
+ * coarse row per thread at a time (each with its own marker array), the fine rows of an
+ * aggregate in increasing order: the same sums in the same order whatever the threads. */
+static void galerkin(lub_amg *g, const lub_csr *A, const lub_amg_level *lv, lub_csr *C)
+{
+    const int nc = lv->nc, nt = omp_get_max_threads();
+    const int *agg = lv->agg, *ms = lv->mstart, *mr = lv->mrows;
+    const int par = A->n > LUB_LINALG_OMP_MIN;
+    grow_int(&g->mark, &g->mark_cap, (par ? nt : 1) * nc);
     /* pass 1: row lengths (distinct coarse columns) */
-    for (int I = 0; I < nc; I++) mark[I] = -1;
     lub_csr_begin(C, nc);
-    for (int I = 0; I < nc; I++) {
-        int len = 0;
-        for (int t = cnt[I]; t < cnt[I + 1]; t++) {
-            int i = rows[t];
-            for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1]; k++) {
-                int J = agg[A->col[k]];
-                if (mark[J] != I) mark[J] = I, len++;
+#pragma omp parallel if (par)
+    {
+        int *mark = g->mark + (size_t)omp_get_thread_num() * nc;
+        for (int I = 0; I < nc; I++) mark[I] = -1;
+#pragma omp for schedule(static)
+        for (int I = 0; I < nc; I++) {
+            int len = 0;
+            for (int t = ms[I]; t < ms[I + 1]; t++) {
+                const int i = mr[t];
+                for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1]; k++) {
+                    const int J = agg[A->col[k]];
+                    if (mark[J] != I) mark[J] = I, len++;
+                }
             }
+            lub_csr_set_row_length(C, I, len);
         }
-        lub_csr_set_row_length(C, I, len);
     }
     lub_csr_alloc(C);
     /* pass 2: sums; mark[J] = position of J in the current coarse row */
-    for (int I = 0; I < nc; I++) mark[I] = -1;
-    for (int I = 0; I < nc; I++) {
-        int *c = lub_csr_row_col(C, I);
-        double *v = lub_csr_row_val(C, I);
-        int len = 0;
-        for (int t = cnt[I]; t < cnt[I + 1]; t++) {
-            int i = rows[t];
-            for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1]; k++) {
-                int J = agg[A->col[k]];
-                if (mark[J] < 0) {
-                    mark[J] = len;
-                    c[len] = J;
-                    v[len++] = 0.0;
+#pragma omp parallel if (par)
+    {
+        int *mark = g->mark + (size_t)omp_get_thread_num() * nc;
+        for (int I = 0; I < nc; I++) mark[I] = -1;
+#pragma omp for schedule(static)
+        for (int I = 0; I < nc; I++) {
+            int *c = lub_csr_row_col(C, I);
+            double *v = lub_csr_row_val(C, I);
+            int len = 0;
+            for (int t = ms[I]; t < ms[I + 1]; t++) {
+                const int i = mr[t];
+                for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1]; k++) {
+                    const int J = agg[A->col[k]];
+                    if (mark[J] < 0) {
+                        mark[J] = len;
+                        c[len] = J;
+                        v[len++] = 0.0;
+                    }
+                    v[mark[J]] += A->val[k];
                 }
-                v[mark[J]] += A->val[k];
             }
+            for (int q = 0; q < len; q++) mark[c[q]] = -1;
         }
-        for (int q = 0; q < len; q++) mark[c[q]] = -1;
     }
     lub_csr_finish(C);
 }
@@ -189,7 +210,8 @@ int lub_amg_setup(lub_amg *g, const lub_csr *A)
             g->coarse_gs = 1;
             return 0;
         }
-        galerkin(g, M, lv->agg, lv->nc, &g->lev[l + 1].own);
+        members(lv, n);
+        galerkin(g, M, lv, &g->lev[l + 1].own);
         M = &g->lev[l + 1].own;
     }
 }
@@ -318,8 +340,16 @@ static void vcycle(lub_amg *g, int l, const double *b, double *x)
         residual(A, b, x, res);
     else
         residual_after_forward(g, A, x, res);
-    memset(c->b, 0, (size_t)lv->nc * sizeof *c->b);
-    for (int i = 0; i < n; i++) c->b[agg[i]] += res[i];
+    /* (gathered per aggregate, its members in increasing order: the sums of a serial
+     * scatter c->b[agg[i]] += res[i], in parallel) */
+    const int nc = lv->nc, *ms = lv->mstart, *mr = lv->mrows;
+    double *bc = c->b;
+#pragma omp parallel for schedule(static) if (n > LUB_LINALG_OMP_MIN)
+    for (int I = 0; I < nc; I++) {
+        double s = 0.0;
+        for (int t = ms[I]; t < ms[I + 1]; t++) s += res[mr[t]];
+        bc[I] = s;
+    }
     vcycle(g, l + 1, c->b, c->x);
     const double alpha = g->alpha;
     const double *xc = c->x;

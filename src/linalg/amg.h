@@ -38,9 +38,11 @@ typedef struct lub_amg_level {
     lub_csr own;
     int *agg;      /* n: aggregate (coarse unknown) of each node (not on the coarsest level) */
     int nc;        /* number of aggregates */
+    int *mstart;   /* nc + 1: the members of aggregate I are mrows[mstart[I] .. mstart[I+1]) */
+    int *mrows;    /* n: the nodes of each aggregate, in increasing order */
     double *b, *x; /* right-hand side and correction of this level (levels >= 1) */
     double *tmp;   /* residual / previous iterate */
-    int n_cap, agg_cap;
+    int n_cap, agg_cap, mstart_cap, mrows_cap;
 } lub_amg_level;
 
 typedef struct lub_amg {
@@ -57,9 +59,9 @@ typedef struct lub_amg {
     double *dense;
     size_t dense_cap;
     int dense_n, coarse_gs;
-    /* Galerkin product workspace */
-    int *cnt, *rows, *mark;
-    int cnt_cap, rows_cap, mark_cap;
+    /* Galerkin product workspace: one marker array of the coarse size per thread */
+    int *mark;
+    int mark_cap;
 } lub_amg;
 
 /* theta 0.5, alpha 1.8, coarse_max 400. */
