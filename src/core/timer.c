@@ -1,6 +1,9 @@
 /* lubkit wall-clock timing (see timer.h). */
 #include "core/timer.h"
 
+#include <math.h>
+#include <stdio.h>
+
 #include "core/error.h"
 
 int lub_timers_add(lub_timers *t, const char *name)
@@ -10,4 +13,21 @@ int lub_timers_add(lub_timers *t, const char *name)
     t->seconds[t->n] = 0.0;
     t->started[t->n] = 0.0;
     return t->n++;
+}
+
+double lub_load_average(const char *path)
+{
+    FILE *f = fopen(path ? path : "/proc/loadavg", "r");
+    if (!f) return -1.0;
+    double load = -1.0;
+    if (fscanf(f, "%lf", &load) != 1 || !(load >= 0)) load = -1.0;
+    fclose(f);
+    return load;
+}
+
+int lub_threads_oversubscribed(double load, int cores, int threads, int *fit)
+{
+    int free_cores = load >= 0 ? (int)floor(cores - load + 0.5) : cores;
+    if (fit) *fit = free_cores < 1 ? 1 : free_cores > threads ? threads : free_cores;
+    return threads > 1 && load >= 0 && load + threads > cores + 0.5;
 }

@@ -14,6 +14,7 @@
 
 #include "core/args.h"
 #include "core/error.h"
+#include "core/timer.h"
 #include "geometry/geometry.h"
 #include "io/particles_io.h"
 #include "io/table.h"
@@ -117,6 +118,13 @@ static void print_header(const lubfoam_run *r)
                 r->step, m->dim);
     lub_message("Particles: %zu (fluid %zu, wall %zu, dummy %zu), threads %d", r->P.n, cnt[0],
                 cnt[1], cnt[2], omp_get_max_threads());
+    const double load = lub_load_average(NULL);
+    int fit = 1;
+    if (lub_threads_oversubscribed(load, omp_get_num_procs(), omp_get_max_threads(), &fit))
+        lub_warning("the machine is busy (load average %.2f on %d cores) and this run has %d "
+                    "threads: threads that wait for each other on shared cores can make every "
+                    "step several times slower; OMP_NUM_THREADS=%d may be faster",
+                    load, omp_get_num_procs(), omp_get_max_threads(), fit);
     if (r->opt) {
         const lub_opt *o = r->opt;
         char desc[1024];

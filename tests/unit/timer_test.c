@@ -1,0 +1,66 @@
+/* core/timer: the phase timers, the load average and the oversubscription test that lubFoam
+ * warns with at start-up. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <unistd.h>
+
+#include "core/timer.h"
+#include "test.h"
+
+static void test_timers(void)
+{
+    lub_timers t = {0};
+    int a = lub_timers_add(&t, "a"), b = lub_timers_add(&t, "b");
+    CHECK(a == 0 && b == 1 && t.n == 2);
+    lub_timer_start(&t, a);
+    double w0 = lub_wtime();
+    while (lub_wtime() - w0 < 0.01) {
+    }
+    lub_timer_stop(&t, a);
+    CHECK(t.seconds[a] >= 0.01 && t.seconds[a] < 1.0);
+    CHECK(t.seconds[b] == 0.0);
+}
+
+static void test_load_average(void)
+{
+    char path[] = "/tmp/lub_loadavg_XXXXXX";
+    int fd = mkstemp(path);
+    CHECK(fd >= 0);
+    FILE *f = fdopen(fd, "w");
+    fputs("1.52 0.80 0.40 3/120 4567\n", f);
+    fclose(f);
+    CHECK_NEAR(lub_load_average(path), 1.52, 1e-15);
+    f = fopen(path, "w");
+    fputs("garbage\n", f);
+    fclose(f);
+    CHECK(lub_load_average(path) == -1.0);
+    remove(path);
+    CHECK(lub_load_average(path) == -1.0); /* missing file */
+}
+
+static void test_oversubscribed(void)
+{
+    int fit = 0;
+    /* 2 cores, idle: 2 threads fit */
+    CHECK(!lub_threads_oversubscribed(0.05, 2, 2, &fit) && fit == 2);
+    /* one other run: 1 fits, 2 threads share a core */
+    CHECK(lub_threads_oversubscribed(1.0, 2, 2, &fit) && fit == 1);
+    /* two other runs: still at least 1 */
+    CHECK(lub_threads_oversubscribed(2.0, 2, 2, &fit) && fit == 1);
+    /* one thread is never oversubscribed in this sense (nothing waits for it) */
+    CHECK(!lub_threads_oversubscribed(3.0, 2, 1, &fit) && fit == 1);
+    /* unknown load */
+    CHECK(!lub_threads_oversubscribed(-1.0, 2, 2, &fit) && fit == 2);
+    /* 8 cores, load 3: 5 threads fit, 6 do not */
+    CHECK(!lub_threads_oversubscribed(3.0, 8, 5, &fit) && fit == 5);
+    CHECK(lub_threads_oversubscribed(3.0, 8, 6, &fit) && fit == 5);
+    CHECK(lub_threads_oversubscribed(1.0, 2, 2, NULL)); /* fit may be NULL */
+}
+
+int main(void)
+{
+    RUN(test_timers);
+    RUN(test_load_average);
+    RUN(test_oversubscribed);
+    return test_summary();
+}
