@@ -17,7 +17,9 @@ static void test_timers(void)
     while (lub_wtime() - w0 < 0.01) {
     }
     lub_timer_stop(&t, a);
-    CHECK(t.seconds[a] >= 0.01 && t.seconds[a] < 1.0);
+    /* at least the span waited for (no upper bound: a timed assertion would depend on the
+     * machine's load) */
+    CHECK(t.seconds[a] >= 0.01 && isfinite(t.seconds[a]));
     CHECK(t.seconds[b] == 0.0);
 }
 
