@@ -26,6 +26,22 @@ static void on_signal(int sig)
     stop_signal = sig;
 }
 
+/* SIGINT and SIGTERM ask for the current state to be written and the run to stop.  The
+ * handler stays installed (sigaction without SA_RESETHAND): with -std=c11 glibc's signal()
+ * has System V semantics, so a second signal before the state was written (lubSweep signals
+ * the run's process group as well as its own children; a second Ctrl-C) used to kill the run
+ * and lose the state.  SA_RESTART: system calls of the writers are resumed, not failed. */
+static void install_stop_handlers(void)
+{
+    struct sigaction sa;
+    memset(&sa, 0, sizeof sa);
+    sa.sa_handler = on_signal;
+    sigemptyset(&sa.sa_mask);
+    sa.sa_flags = SA_RESTART;
+    sigaction(SIGINT, &sa, NULL);
+    sigaction(SIGTERM, &sa, NULL);
+}
+
 static void format_hms(double s, char *buf, size_t size)
 {
     if (!isfinite(s) || s < 0) {
@@ -412,8 +428,7 @@ int main(int argc, char **argv)
     lubfoam_check_levels(&r, &geo);
     lub_geometry_free(&geo);
 
-    signal(SIGINT, on_signal);
-    signal(SIGTERM, on_signal);
+    install_stop_handlers();
     const int tty = isatty(STDOUT_FILENO);
     const double wall0 = lub_wtime();
     const long step0 = r.step;
