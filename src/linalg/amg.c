@@ -14,6 +14,7 @@ void lub_amg_init(lub_amg *g)
     g->theta = 0.5;
     g->alpha = 1.8;
     g->coarse_max = 400;
+    g->cycle = 2;
     for (int l = 0; l < LUB_AMG_MAX_LEVELS; l++) lub_csr_init(&g->lev[l].own);
 }
 
@@ -25,6 +26,9 @@ void lub_amg_free(lub_amg *g)
         free(g->lev[l].b);
         free(g->lev[l].x);
         free(g->lev[l].tmp);
+        free(g->lev[l].r2);
+        free(g->lev[l].e2);
+        free(g->lev[l].valf);
         free(g->lev[l].mstart);
         free(g->lev[l].mrows);
     }
@@ -40,14 +44,16 @@ static void grow_int(int **p, int *cap, int n)
     *p = lub_realloc(*p, (size_t)*cap * sizeof **p);
 }
 
-/* Greedy aggregation on the strong connections; returns the number of aggregates. */
-static int aggregate(const lub_csr *A, double theta, int *agg)
+/* Greedy aggregation on the strong connections of the rows [r0, r1), numbering the aggregates
+ * from 0; returns their number.  Only connections inside the range count (the rows of other
+ * ranges are aggregated by other threads at the same time), so the aggregates depend on the
+ * ranges, not on the timing. */
+static int aggregate_rows(const lub_csr *A, double theta, int *agg, int r0, int r1)
 {
-    const int n = A->n;
     int nc = 0;
-    for (int i = 0; i < n; i++) agg[i] = -1;
+    for (int i = r0; i < r1; i++) agg[i] = -1;
     /* pass 1: a node with all strong neighbours free starts an aggregate with them */
-    for (int i = 0; i < n; i++) {
+    for (int i = r0; i < r1; i++) {
         if (agg[i] >= 0) continue;
         double mx = 0;
         for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1]; k++)
@@ -56,28 +62,54 @@ static int aggregate(const lub_csr *A, double theta, int *agg)
         int free_all = 1;
         for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1] && free_all; k++) {
             int j = A->col[k];
-            if (j != i && -A->val[k] > 0 && -A->val[k] >= cut && agg[j] >= 0) free_all = 0;
+            if (j != i && j >= r0 && j < r1 && -A->val[k] > 0 && -A->val[k] >= cut &&
+                agg[j] >= 0)
+                free_all = 0;
         }
         if (!free_all) continue;
         agg[i] = nc;
         for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1]; k++) {
             int j = A->col[k];
-            if (j != i && -A->val[k] > 0 && -A->val[k] >= cut) agg[j] = nc;
+            if (j != i && j >= r0 && j < r1 && -A->val[k] > 0 && -A->val[k] >= cut) agg[j] = nc;
         }
         nc++;
     }
     /* pass 2: the rest join the aggregate of their strongest aggregated neighbour */
-    for (int i = 0; i < n; i++) {
+    for (int i = r0; i < r1; i++) {
         if (agg[i] >= 0) continue;
         double best = 0;
         int bj = -1;
         for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1]; k++) {
             int j = A->col[k];
-            if (j != i && agg[j] >= 0 && -A->val[k] > best) best = -A->val[k], bj = j;
+            if (j != i && j >= r0 && j < r1 && agg[j] >= 0 && -A->val[k] > best)
+                best = -A->val[k], bj = j;
         }
         agg[i] = bj >= 0 ? agg[bj] : nc++;
     }
     return nc;
+}
+
+/* Aggregation of all rows: in nb contiguous ranges of rows at once (the smoother's blocks),
+ * the aggregates of range t numbered after those of ranges 0 .. t-1.  Returns their number. */
+static int aggregate(const lub_csr *A, double theta, int *agg, int nb)
+{
+    const int n = A->n;
+    int count[LUB_AMG_MAX_BLOCKS + 1] = {0};
+    if (nb < 1 || n <= LUB_LINALG_OMP_MIN) nb = 1;
+    if (nb > LUB_AMG_MAX_BLOCKS) nb = LUB_AMG_MAX_BLOCKS;
+#pragma omp parallel for schedule(static, 1) num_threads(nb) if (nb > 1)
+    for (int t = 0; t < nb; t++) {
+        const int r0 = (int)((long)n * t / nb), r1 = (int)((long)n * (t + 1) / nb);
+        count[t + 1] = aggregate_rows(A, theta, agg, r0, r1);
+    }
+    for (int t = 0; t < nb; t++) count[t + 1] += count[t];
+    if (nb > 1)
+#pragma omp parallel for schedule(static, 1) num_threads(nb)
+        for (int t = 0; t < nb; t++) {
+            const int r0 = (int)((long)n * t / nb), r1 = (int)((long)n * (t + 1) / nb);
+            for (int i = r0; i < r1; i++) agg[i] += count[t];
+        }
+    return count[nb];
 }
 
 /* The members of each aggregate in increasing order (a counting sort of agg): the rows the
@@ -183,12 +215,28 @@ static int coarse_factor(lub_amg *g, const lub_csr *A)
     return 0;
 }
 
+/* The level's matrix values in single precision, for its smoother (see amg.h). */
+static void smoother_values(lub_amg_level *lv)
+{
+    const lub_csr *A = lv->A;
+    const int nnz = A->nnz;
+    if (nnz > lv->valf_cap || !lv->valf) {
+        lv->valf_cap = nnz + nnz / 8 + 64;
+        lv->valf = lub_realloc(lv->valf, (size_t)lv->valf_cap * sizeof *lv->valf);
+    }
+    const double *val = A->val;
+    float *vf = lv->valf;
+#pragma omp parallel for schedule(static) if (nnz > 16 * LUB_LINALG_OMP_MIN)
+    for (int k = 0; k < nnz; k++) vf[k] = (float)val[k];
+}
+
 int lub_amg_setup(lub_amg *g, const lub_csr *A)
 {
     if (!A->finished) lub_bug("lub_amg_setup on a matrix not finished (lub_csr_finish)");
     g->nlev = 0;
     g->coarse_gs = 0;
     g->nblocks = g->blocks > 0 ? g->blocks : omp_get_max_threads();
+    if (g->nblocks > LUB_AMG_MAX_BLOCKS) g->nblocks = LUB_AMG_MAX_BLOCKS;
     const lub_csr *M = A;
     for (int l = 0;; l++) {
         lub_amg_level *lv = &g->lev[l];
@@ -199,11 +247,14 @@ int lub_amg_setup(lub_amg *g, const lub_csr *A)
             lv->b = lub_realloc(lv->b, (size_t)lv->n_cap * sizeof *lv->b);
             lv->x = lub_realloc(lv->x, (size_t)lv->n_cap * sizeof *lv->x);
             lv->tmp = lub_realloc(lv->tmp, (size_t)lv->n_cap * sizeof *lv->tmp);
+            lv->r2 = lub_realloc(lv->r2, (size_t)lv->n_cap * sizeof *lv->r2);
+            lv->e2 = lub_realloc(lv->e2, (size_t)lv->n_cap * sizeof *lv->e2);
         }
+        smoother_values(lv);
         g->nlev = l + 1;
         if (n <= g->coarse_max) return coarse_factor(g, M);
         grow_int(&lv->agg, &lv->agg_cap, n);
-        lv->nc = aggregate(M, g->theta, lv->agg);
+        lv->nc = aggregate(M, g->theta, lv->agg, g->nblocks);
         if (lv->nc > 0.9 * n || l == LUB_AMG_MAX_LEVELS - 1) {
             /* no real coarsening (e.g. no off-diagonal couplings): this level is the
              * coarsest, smoothed instead of solved */
@@ -216,27 +267,45 @@ int lub_amg_setup(lub_amg *g, const lub_csr *A)
     }
 }
 
-/* One Gauss-Seidel sweep (forward or backward) for A x = b from the current x, on the rows
- * [r0, r1) only, reading the unknowns outside the range from xo ("hybrid" Gauss-Seidel:
- * Gauss-Seidel inside a block, Jacobi between blocks, so that blocks run in parallel).
- * xo == NULL: the unknowns outside are 0 (a sweep from x = 0). */
-static void gs_rows(const lub_csr *A, const double *b, double *x, const double *xo, int r0, int r1,
-                    int forward)
+/* One Gauss-Seidel sweep (forward or backward) for A x = b on the rows [r0, r1) only, with
+ * the level's single-precision values vf ("hybrid" Gauss-Seidel: Gauss-Seidel inside a
+ * block, Jacobi between blocks, so that blocks run in parallel).
+ *   xo == NULL: the sweep from x = 0, forward: the unknowns outside the range and those not
+ *       yet swept are 0, so only the lower part of each row inside the range is read (columns
+ *       are sorted: those of earlier blocks come first, then the ones below the diagonal);
+ *   xo != NULL: the sweep from the current x, reading the unknowns outside the range from
+ *       xo (a copy of x made before the sweep: another block may be updating them).  A row
+ *       whose columns all lie in the range takes them from x, without a test per entry. */
+static void gs_rows(const lub_csr *A, const float *vf, const double *b, double *x,
+                    const double *xo, int r0, int r1, int forward)
 {
     const int *rp = A->row_ptr, *col = A->col, *diag = A->diag;
-    const double *val = A->val;
+    if (!xo) {
+        if (!forward) lub_bug("Gauss-Seidel sweep from 0 must be forward");
+        for (int i = r0; i < r1; i++) {
+            double s = b[i];
+            int k = rp[i];
+            while (k < diag[i] && col[k] < r0) k++;
+            for (; k < diag[i]; k++) s -= vf[k] * x[col[k]];
+            x[i] = s / vf[diag[i]];
+        }
+        return;
+    }
     for (int t = r0; t < r1; t++) {
         const int i = forward ? t : r0 + r1 - 1 - t;
+        const int k0 = rp[i], k1 = rp[i + 1], d = diag[i];
         double s = b[i];
-        for (int k = rp[i]; k < rp[i + 1]; k++) {
-            const int j = col[k];
-            if (j == i) continue;
-            if (j >= r0 && j < r1)
-                s -= val[k] * x[j];
-            else if (xo)
-                s -= val[k] * xo[j];
+        if (col[k0] >= r0 && col[k1 - 1] < r1) {
+            for (int k = k0; k < d; k++) s -= vf[k] * x[col[k]];
+            for (int k = d + 1; k < k1; k++) s -= vf[k] * x[col[k]];
+        } else {
+            for (int k = k0; k < k1; k++) {
+                const int j = col[k];
+                if (j == i) continue;
+                s -= vf[k] * (j >= r0 && j < r1 ? x[j] : xo[j]);
+            }
         }
-        x[i] = s / val[diag[i]];
+        x[i] = s / vf[d];
     }
 }
 
@@ -250,7 +319,8 @@ static void gs_sweep(lub_amg *g, lub_amg_level *lv, const double *b, double *x, 
     const int n = A->n;
     const int nb = n > LUB_LINALG_OMP_MIN ? g->nblocks : 1;
     if (nb == 1) {
-        gs_rows(A, b, x, NULL, 0, n, forward);
+        /* one block: nothing outside it (x itself serves as xo) */
+        gs_rows(A, lv->valf, b, x, from_zero ? NULL : x, 0, n, forward);
         return;
     }
     const double *xo = NULL;
@@ -261,18 +331,17 @@ static void gs_sweep(lub_amg *g, lub_amg_level *lv, const double *b, double *x, 
 #pragma omp parallel for schedule(static, 1) num_threads(nb)
     for (int t = 0; t < nb; t++) {
         int r0 = (int)((long)n * t / nb), r1 = (int)((long)n * (t + 1) / nb);
-        if (from_zero)
-            for (int i = r0; i < r1; i++) x[i] = 0.0;
-        gs_rows(A, b, x, xo, r0, r1, forward);
+        gs_rows(A, lv->valf, b, x, xo, r0, r1, forward);
     }
 }
 
-/* res = b - A x */
-static void residual(const lub_csr *A, const double *b, const double *x, double *res)
+/* res = b - A x, with the values vf (the smoother's, or the level's own) */
+static void residual(const lub_csr *A, const float *vf, const double *b, const double *x,
+                     double *res)
 {
     const int n = A->n;
     const int *rp = A->row_ptr, *col = A->col;
-    const double *val = A->val;
+    const float *val = vf;
 #pragma omp parallel for schedule(static) if (n > LUB_LINALG_OMP_MIN)
     for (int i = 0; i < n; i++) {
         double s = b[i];
@@ -287,12 +356,14 @@ static void residual(const lub_csr *A, const double *b, const double *x, double 
  *     (b - A x)_i = - sum_{j > i} a_ij x_j - sum_{j < r0} a_ij x_j,
  * the strict upper part of the row and its few columns in earlier blocks (columns are sorted,
  * so those come first).  Equal to residual() to round-off (unit test). */
-static void residual_after_forward(const lub_amg *g, const lub_csr *A, const double *x, double *res)
+static void residual_after_forward(const lub_amg *g, const lub_amg_level *lv, const double *x,
+                                   double *res)
 {
+    const lub_csr *A = lv->A;
     const int n = A->n;
     const int nb = n > LUB_LINALG_OMP_MIN ? g->nblocks : 1;
     const int *rp = A->row_ptr, *col = A->col, *diag = A->diag;
-    const double *val = A->val;
+    const float *val = lv->valf;
 #pragma omp parallel for schedule(static, 1) num_threads(nb) if (nb > 1)
     for (int t = 0; t < nb; t++) {
         const int r0 = (int)((long)n * t / nb), r1 = (int)((long)n * (t + 1) / nb);
@@ -305,7 +376,10 @@ static void residual_after_forward(const lub_amg *g, const lub_csr *A, const dou
     }
 }
 
-static void vcycle(lub_amg *g, int l, const double *b, double *x)
+/* One cycle on level l for A_l x = b from x = 0: pre-smoothing, the coarse correction (the
+ * cycle on level l + 1, repeated g->cycle times on the levels above the coarsest: V or W),
+ * post-smoothing. */
+static void mg_cycle(lub_amg *g, int l, const double *b, double *x)
 {
     lub_amg_level *lv = &g->lev[l];
     const lub_csr *A = lv->A;
@@ -332,14 +406,13 @@ static void vcycle(lub_amg *g, int l, const double *b, double *x)
     }
     lub_amg_level *c = &g->lev[l + 1];
     const int *agg = lv->agg;
-    if (n <= LUB_LINALG_OMP_MIN || g->nblocks == 1) memset(x, 0, (size_t)n * sizeof *x);
-    gs_sweep(g, lv, b, x, 1, 1);
+    gs_sweep(g, lv, b, x, 1, 1); /* from 0: reads no x it has not written */
     /* restrict the residual: b_c = P^T (b - A x) */
     double *res = lv->tmp;
     if (g->unfused)
-        residual(A, b, x, res);
+        residual(A, lv->valf, b, x, res);
     else
-        residual_after_forward(g, A, x, res);
+        residual_after_forward(g, lv, x, res);
     /* (gathered per aggregate, its members in increasing order: the sums of a serial
      * scatter c->b[agg[i]] += res[i], in parallel) */
     const int nc = lv->nc, *ms = lv->mstart, *mr = lv->mrows;
@@ -350,7 +423,22 @@ static void vcycle(lub_amg *g, int l, const double *b, double *x)
         for (int t = ms[I]; t < ms[I + 1]; t++) s += res[mr[t]];
         bc[I] = s;
     }
-    vcycle(g, l + 1, c->b, c->x);
+    mg_cycle(g, l + 1, c->b, c->x);
+    if (l + 1 < g->nlev - 1) {
+        /* W-cycle: further cycles on the coarse level for its residual (the coarsest level
+         * is solved exactly); the coarse levels cost a fraction of the finest, and on the MPS
+         * pressure matrix the W-cycle reaches the iteration count of an exact coarse solve */
+        const lub_csr *Ac = c->A;
+        const int ncl = Ac->n;
+        for (int k = 1; k < g->cycle; k++) {
+            residual(Ac, c->valf, c->b, c->x, c->r2);
+            mg_cycle(g, l + 1, c->r2, c->e2);
+            double *xcl = c->x;
+            const double *e = c->e2;
+#pragma omp parallel for schedule(static) if (ncl > LUB_LINALG_OMP_MIN)
+            for (int i = 0; i < ncl; i++) xcl[i] += e[i];
+        }
+    }
     const double alpha = g->alpha;
     const double *xc = c->x;
 #pragma omp parallel for schedule(static) if (n > LUB_LINALG_OMP_MIN)
@@ -360,5 +448,5 @@ static void vcycle(lub_amg *g, int l, const double *b, double *x)
 
 void lub_amg_apply(lub_amg *g, const double *r, double *z)
 {
-    vcycle(g, 0, r, z);
+    mg_cycle(g, 0, r, z);
 }

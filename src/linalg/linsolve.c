@@ -44,9 +44,12 @@ void lub_linsolver_describe(const lub_linsolver *s, char *buf, size_t size)
                  lub_cholmod_ordering_names[s->o.cholmod.ordering],
                  lub_cholmod_factor_names[s->o.cholmod.factor]);
     } else {
-        snprintf(buf, size, "pcg (%s), tolerance %g, maxIter %d%s",
-                 lub_precond_choice_names[s->o.pcg.precond], s->o.pcg.tolerance, s->o.pcg.max_iter,
-                 s->o.pcg.warm_start ? ", warm start" : "");
+        snprintf(buf, size, "pcg (%s%s), tolerance %g, maxIter %d%s",
+                 lub_precond_choice_names[s->o.pcg.precond],
+                 s->o.pcg.precond == LUB_PRECOND_AMG
+                     ? (s->o.pcg.cycle == 1 ? ", V-cycle" : ", W-cycle")
+                     : "",
+                 s->o.pcg.tolerance, s->o.pcg.max_iter, s->o.pcg.warm_start ? ", warm start" : "");
     }
 }
 

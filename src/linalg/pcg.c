@@ -19,9 +19,11 @@
 const char *const lub_precond_choice_names[] = {"none", "jacobi", "ic0", "sgs",
                                                 "bic0", "amg",    NULL};
 
+const char *const lub_amg_cycle_names[] = {"V", "W", NULL};
+
 lub_pcg_options lub_pcg_defaults(void)
 {
-    lub_pcg_options o = {1e-8, 1000, LUB_PRECOND_JACOBI, 0, 1.0, 0};
+    lub_pcg_options o = {1e-8, 1000, LUB_PRECOND_JACOBI, 0, 1.0, 0, 2};
     return o;
 }
 
@@ -235,6 +237,7 @@ double lub_pcg_setup(lub_pcg_work *w, const lub_csr *A, const lub_pcg_options *o
     w->precond_used = o->precond;
     w->omega = o->omega;
     w->blocks_opt = o->blocks;
+    w->amg.cycle = o->cycle;
     w->ic_shift = 0.0;
     switch (o->precond) {
     case LUB_PRECOND_NONE:
@@ -470,6 +473,8 @@ void lub_pcg_solve_multi(lub_pcg_work *w, const lub_csr *A, int nrhs, const doub
         (o->precond == LUB_PRECOND_SGS && w->omega != o->omega) ||
         (o->precond == LUB_PRECOND_BIC0 && w->blocks_opt != o->blocks))
         lub_pcg_setup(w, A, o);
+    if (o->cycle < 1 || o->cycle > 2) lub_bug("bad AMG cycle %d (1: V, 2: W)", o->cycle);
+    w->amg.cycle = o->cycle; /* the cycle is no part of the set-up */
     const double tol = o->tolerance;
     double *r[LUB_PCG_MAX_RHS], *z[LUB_PCG_MAX_RHS], *p[LUB_PCG_MAX_RHS], *q[LUB_PCG_MAX_RHS];
     double bnorm[LUB_PCG_MAX_RHS], rz[LUB_PCG_MAX_RHS], rr[LUB_PCG_MAX_RHS];

@@ -36,8 +36,9 @@
  *           between blocks are dropped from the factor, so the factorisation and both
  *           sweeps run in parallel; more iterations than ic0 (2 blocks: +20% on the 80k
  *           MPS-like matrix).  With 1 block it is ic0.
- *   amg     one V-cycle of aggregation algebraic multigrid (amg.h): an iteration count that
- *           hardly grows with the particle count, block-parallel smoothing.  The fastest
+ *   amg     one W-cycle (or V-cycle: options.cycle) of aggregation algebraic multigrid
+ *           (amg.h): an iteration count that hardly grows with the particle count,
+ *           block-parallel smoothing and aggregation.  The fastest
  *           here: 80k MPS-like unknowns to 1e-8 in 19 iterations, about 6 times faster than
  *           ic0 on 2 threads (tests/bench/linalg_bench.c).  If its coarsest matrix is not
  *           positive definite, Jacobi is used and ic_shift = -1.
@@ -67,6 +68,8 @@ typedef enum {
 
 /* NULL-terminated, indexed by lub_precond: usable with lub_dict_choice (src/io/dict.h). */
 extern const char *const lub_precond_choice_names[];
+/* The AMG cycles by name, indexed by lub_pcg_options.cycle - 1: "V", "W". */
+extern const char *const lub_amg_cycle_names[];
 
 typedef struct lub_pcg_options {
     double tolerance; /* relative residual ||b - A x|| / ||b|| */
@@ -75,9 +78,10 @@ typedef struct lub_pcg_options {
     int warm_start; /* 1: x given to lub_pcg_solve is the initial guess; 0: start from 0 */
     double omega;   /* SSOR relaxation, 0 < omega < 2 (sgs only) */
     int blocks;     /* bic0: number of blocks; 0 = one per OpenMP thread */
+    int cycle;      /* amg: 1 V-cycle, 2 W-cycle (default) */
 } lub_pcg_options;
 
-/* tolerance 1e-8, max_iter 1000, jacobi, no warm start, omega 1, blocks 0. */
+/* tolerance 1e-8, max_iter 1000, jacobi, no warm start, omega 1, blocks 0, W-cycle. */
 lub_pcg_options lub_pcg_defaults(void);
 
 typedef struct lub_pcg_work {

@@ -15,8 +15,8 @@
  *
  * system/solution.yaml:
  *
- *     p: { solver: pcg, preconditioner: amg, tolerance: 1e-8, maxIter: 2000,
- *          warmStart: true, onFailure: stop }          # stop | continue
+ *     p: { solver: pcg, preconditioner: amg, cycle: W, tolerance: 1e-8, maxIter: 2000,
+ *          warmStart: true, onFailure: stop }          # cycle V | W; stop | continue
  *     U: { solver: pcg, preconditioner: jacobi, tolerance: 1e-8, maxIter: 500 }
  */
 #include <math.h>
@@ -72,6 +72,7 @@ static void read_linsolver(lub_node *map, lub_linsolver_options *o, int *cont)
         lub_dict_real_or(map, "tolerance", o->pcg.tolerance, (lub_range){0.0, 1.0, 1, 1});
     o->pcg.max_iter = (int)lub_dict_int_or(map, "maxIter", o->pcg.max_iter, 1, 100000000);
     o->pcg.warm_start = lub_dict_bool_or(map, "warmStart", o->pcg.warm_start);
+    o->pcg.cycle = 1 + lub_dict_choice(map, "cycle", lub_amg_cycle_names, o->pcg.cycle - 1);
     o->cholmod.ordering =
         lub_dict_choice(map, "ordering", lub_cholmod_ordering_names, o->cholmod.ordering);
     *cont = lub_dict_choice(map, "onFailure", fail, 0);
