@@ -62,8 +62,7 @@ static int aggregate_rows(const lub_csr *A, double theta, int *agg, int r0, int 
         int free_all = 1;
         for (int k = A->row_ptr[i]; k < A->row_ptr[i + 1] && free_all; k++) {
             int j = A->col[k];
-            if (j != i && j >= r0 && j < r1 && -A->val[k] > 0 && -A->val[k] >= cut &&
-                agg[j] >= 0)
+            if (j != i && j >= r0 && j < r1 && -A->val[k] > 0 && -A->val[k] >= cut && agg[j] >= 0)
                 free_all = 0;
         }
         if (!free_all) continue;
@@ -276,8 +275,8 @@ int lub_amg_setup(lub_amg *g, const lub_csr *A)
  *   xo != NULL: the sweep from the current x, reading the unknowns outside the range from
  *       xo (a copy of x made before the sweep: another block may be updating them).  A row
  *       whose columns all lie in the range takes them from x, without a test per entry. */
-static void gs_rows(const lub_csr *A, const float *vf, const double *b, double *x,
-                    const double *xo, int r0, int r1, int forward)
+static void gs_rows(const lub_csr *A, const float *vf, const double *b, double *x, const double *xo,
+                    int r0, int r1, int forward)
 {
     const int *rp = A->row_ptr, *col = A->col, *diag = A->diag;
     if (!xo) {

@@ -24,12 +24,13 @@
  *   - the smoother reads the matrix values in single precision (a copy made at set-up):
  *     the sweeps are memory-bound, and a preconditioner needs no more than that (the
  *     IC(0) factor is stored so too); CG's own products use the double values.  A forward
- *     sweep from 0 reads only the lower triangle of each row (the rest multiplies zeros).  Positive definiteness is not guaranteed by theory for
- *     alpha > 1 with inexact (recursive) coarse solves; it holds on the Poisson and MPS
- *     matrices (unit test), and PCG checks r.z > 0 at every iteration, so a failure would be
- *     reported as LUB_SOLVE_BREAKDOWN, never as a wrong answer.
+ *     sweep from 0 reads only the lower triangle of each row (the rest multiplies zeros).
+ * Positive definiteness is not guaranteed by theory for alpha > 1 with inexact (recursive)
+ * coarse solves; it holds on the Poisson and MPS matrices (unit test), and PCG checks r.z > 0
+ * at every iteration, so a failure would be reported as LUB_SOLVE_BREAKDOWN, never as a wrong
+ * answer.
  * Measured on the 80k MPS-like matrix (tests/bench/linalg_bench.c): about 20 CG iterations
- * to 1e-8 against 164 with IC(0).
+ * to 1e-8 against 164 with IC(0) (V-cycle).
  * The set-up reuses its arrays (grown, never shrunk), so it allocates nothing in steady
  * state.  With several OpenMP threads the Gauss-Seidel sweeps of the levels above
  * LUB_LINALG_OMP_MIN unknowns are "hybrid": Gauss-Seidel inside one contiguous block of rows
@@ -48,12 +49,12 @@
 typedef struct lub_amg_level {
     const lub_csr *A; /* level 0: the caller's matrix; others: &own */
     lub_csr own;
-    int *agg;      /* n: aggregate (coarse unknown) of each node (not on the coarsest level) */
-    int nc;        /* number of aggregates */
-    int *mstart;   /* nc + 1: the members of aggregate I are mrows[mstart[I] .. mstart[I+1]) */
-    int *mrows;    /* n: the nodes of each aggregate, in increasing order */
-    double *b, *x; /* right-hand side and correction of this level (levels >= 1) */
-    double *tmp;   /* residual / previous iterate */
+    int *agg;        /* n: aggregate (coarse unknown) of each node (not on the coarsest level) */
+    int nc;          /* number of aggregates */
+    int *mstart;     /* nc + 1: the members of aggregate I are mrows[mstart[I] .. mstart[I+1]) */
+    int *mrows;      /* n: the nodes of each aggregate, in increasing order */
+    double *b, *x;   /* right-hand side and correction of this level (levels >= 1) */
+    double *tmp;     /* residual / previous iterate */
     double *r2, *e2; /* W-cycle: residual and correction of the repeated coarse cycles */
     float *valf;     /* the values of A in single precision, for the smoother */
     int valf_cap;

@@ -827,8 +827,9 @@ static void test_amg_cycles(void)
     CHECK(lv >= 4 && lw == lv && l2 == 2);
     CHECK(wc < v);
     CHECK(wc - tg <= (v - tg) / 2); /* at least half the way from the V-cycle to two-grid */
-    printf("  MPS-like 160x80 to 1e-10: V-cycle %d iterations, W-cycle %d, two-grid %d (%d levels)\n",
-           v, wc, tg, lv);
+    printf(
+        "  MPS-like 160x80 to 1e-10: V-cycle %d iterations, W-cycle %d, two-grid %d (%d levels)\n",
+        v, wc, tg, lv);
 
     lub_pcg_work w;
     lub_pcg_work_init(&w);
@@ -842,7 +843,10 @@ static void test_amg_cycles(void)
     for (int I = 0; I < nc; I++) blk[I] = -1;
     for (int i = 0; i < n; i++) {
         const int I = l0->agg[i], t = i < half ? 0 : 1;
-        if (I < 0 || I >= nc) { ok = 0; break; }
+        if (I < 0 || I >= nc) {
+            ok = 0;
+            break;
+        }
         if (blk[I] >= 0 && blk[I] != t) ok = 0;
         blk[I] = t;
         seen[I] = 1;
