@@ -80,8 +80,9 @@ static inline int lub_csr_row_length(const lub_csr *A, int i)
     return A->row_ptr[i + 1] - A->row_ptr[i];
 }
 
-/* End of pass 2: sorts each row by column (insertion sort: neighbour lists in cell order are
- * nearly sorted already), records the diagonal positions, and checks that every column is in
+/* End of pass 2: sorts each row by column (insertion sort: rows assembled from the neighbour
+ * lists of particles in cell order, the diagonal in its place, are sorted or nearly so and
+ * cost about one pass), records the diagonal positions, and checks that every column is in
  * range, no column is repeated in a row and each row has its diagonal.  A violation is a bug
  * of the assembling code (lub_bug).  Parallel over rows (OpenMP). */
 void lub_csr_finish(lub_csr *A);

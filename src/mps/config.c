@@ -11,7 +11,8 @@
  *     freeSurface:      { beta: 0.97, asymmetry: 0.2 }       # T-12 + geometric test
  *     neighbourSkin:    0.2
  *     lsmpsDetMin:      1.0e-2
- *     reorderInterval:  50
+ *     particleOrder:    cells        # cells | rows
+ *     reorderInterval:  1
  *
  * system/solution.yaml:
  *
@@ -46,7 +47,8 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->asymmetry = 0.2;
     c->skin = 0.0;
     c->lsmps_det_min = LUB_MPS_LSMPS_DET_MIN;
-    c->reorder_interval = 50;
+    c->reorder_interval = 1;
+    c->order_rows = 0;
     c->mirror_dummies = 1;
     c->p_solver = lub_linsolver_defaults();
     c->p_solver.pcg.tolerance = 1e-8;
@@ -100,7 +102,10 @@ static void read_schemes(lub_mps_config *c, const char *path)
     c->skin = lub_dict_real_or(r, "neighbourSkin", 0.0, LUB_BETWEEN(0.0, 1.0));
     c->lsmps_det_min =
         lub_dict_real_or(r, "lsmpsDetMin", LUB_MPS_LSMPS_DET_MIN, (lub_range){0.0, 1.0, 1, 1});
-    c->reorder_interval = (int)lub_dict_int_or(r, "reorderInterval", 50, 0, 1000000);
+    static const char *const order[] = {"cells", "rows", NULL};
+    c->order_rows = lub_dict_choice(r, "particleOrder", order, c->order_rows);
+    c->reorder_interval =
+        (int)lub_dict_int_or(r, "reorderInterval", c->reorder_interval, 0, 1000000);
     lub_dict_finish(d);
     lub_dict_free(d);
 }

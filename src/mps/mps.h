@@ -67,7 +67,8 @@ typedef struct {
                                particle is on the surface (0: PND test only) */
     double skin;            /* neighbour search radius re (1 + skin) */
     double lsmps_det_min;   /* LSMPS fallback threshold */
-    int reorder_interval;   /* steps between lattice-row sorts (0: never) */
+    int reorder_interval;   /* steps between sorts of the particles (0: never) */
+    int order_rows;         /* the sort: 0 cell order, 1 lattice rows of l0 */
     int mirror_dummies;     /* dummies take the no-slip ghost velocity 2 U - u_i (viscosity) */
 
     /* system/solution.yaml */

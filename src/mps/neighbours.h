@@ -13,7 +13,10 @@
  *
  * Lists are full (j is in i's list and i in j's), in the caller's particle order (CSR: the
  * neighbours of i are entries start[i] .. start[i+1]-1), each list ordered by neighbouring
- * cell, then by index within a cell: nearly ascending j once the particles are in cell order.  r_ij
+ * cell, then by index within a cell: ascending j once the particles are sorted into cell
+ * order (lub_neighbours_bin, or _order with h = 0; no periodic direction, whose wrapped cells
+ * come first), nearly so while few have moved to another cell since (the rows of a matrix
+ * assembled from the lists then come out sorted or nearly: csr.h).  r_ij
  * = r_j - r_i is the minimum-image displacement in periodic directions.  Pairs are those with
  * |r_ij| < rs = re (1 + skin); w_ij = w(|r_ij|, re) (weight.h), so pairs beyond re (possible only
  * with skin > 0) are stored with w = 0.  |r_ij| is not stored: the sweeps are memory-bound,
