@@ -2,6 +2,7 @@
 #include "mps/neighbours.h"
 
 #include <math.h>
+#include <omp.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -72,10 +73,8 @@ void lub_neighbours_set_box(lub_neighbours *nb, const double lo[3], const double
     if (nb->order_h > 0) lub_neighbours_set_order(nb, nb->order_h);
     if (nb->ncells + 1 > nb->cap_cells) {
         free(nb->cell_start);
-        free(nb->cursor);
         nb->cap_cells = nb->ncells + 1;
         nb->cell_start = lub_malloc(nb->cap_cells * sizeof *nb->cell_start);
-        nb->cursor = lub_malloc(nb->cap_cells * sizeof *nb->cursor);
     }
 }
 
@@ -89,7 +88,7 @@ void lub_neighbours_free(lub_neighbours *nb)
     free(nb->cell);
     free(nb->spos);
     free(nb->cell_start);
-    free(nb->cursor);
+    free(nb->tcount);
     free(nb->order_count);
     memset(nb, 0, sizeof *nb);
 }
@@ -193,27 +192,61 @@ size_t lub_neighbours_bin(lub_neighbours *nb, size_t n, double *const x[3])
     const int dim = nb->dim;
     const size_t nx = (size_t)nb->nc[0], ny = (size_t)nb->nc[1];
     size_t *count = nb->cell_start;
-    memset(count, 0, (nb->ncells + 1) * sizeof *count);
 
-    /* Counting sort of the particles by cell, stable in the particle index. */
-    size_t escaped = 0;
-    for (size_t i = 0; i < n; i++) {
-        double xi[3] = {0, 0, 0};
-        escaped += (size_t)search_position(nb, x, i, xi);
-        size_t c = (size_t)cell_coord(nb, 0, xi[0]) + nx * (size_t)cell_coord(nb, 1, xi[1]);
-        if (dim == 3) c += nx * ny * (size_t)cell_coord(nb, 2, xi[2]);
-        nb->cell[i] = (uint32_t)c;
-        count[c + 1]++;
+    /* Counting sort of the particles by cell, stable in the particle index, in nt contiguous
+     * chunks of particles at once: each chunk counts its particles per cell, the chunks'
+     * places in a cell follow the chunk order, so the result is that of a serial sort.  (One
+     * chunk when the cells outnumber the particles: the counts would cost more than the
+     * particles.) */
+    const size_t ncells = nb->ncells;
+    int nt = omp_get_max_threads();
+    if (nt > 64) nt = 64;
+    if (n < 4096 || ncells > n) nt = 1;
+    if ((size_t)nt * ncells > nb->cap_tcount) {
+        free(nb->tcount);
+        nb->cap_tcount = (size_t)nt * ncells;
+        nb->tcount = lub_malloc(nb->cap_tcount * sizeof *nb->tcount);
     }
-    for (size_t c = 0; c < nb->ncells; c++) count[c + 1] += count[c];
-    memcpy(nb->cursor, nb->cell_start, nb->ncells * sizeof *nb->cursor);
-    for (size_t i = 0; i < n; i++) {
-        size_t k = nb->cursor[nb->cell[i]]++;
-        double xi[3];
-        search_position(nb, x, i, xi);
-        nb->perm[k] = (uint32_t)i;
-        nb->spos[i] = (uint32_t)k;
-        for (int d = 0; d < dim; d++) nb->xs[d][k] = xi[d];
+    size_t esc[64] = {0};
+#pragma omp parallel for schedule(static, 1) num_threads(nt) if (nt > 1)
+    for (int t = 0; t < nt; t++) {
+        uint32_t *cnt = nb->tcount + (size_t)t * ncells;
+        memset(cnt, 0, ncells * sizeof *cnt);
+        const size_t i0 = n * (size_t)t / (size_t)nt, i1 = n * (size_t)(t + 1) / (size_t)nt;
+        for (size_t i = i0; i < i1; i++) {
+            double xi[3] = {0, 0, 0};
+            esc[t] += (size_t)search_position(nb, x, i, xi);
+            size_t c = (size_t)cell_coord(nb, 0, xi[0]) + nx * (size_t)cell_coord(nb, 1, xi[1]);
+            if (dim == 3) c += nx * ny * (size_t)cell_coord(nb, 2, xi[2]);
+            nb->cell[i] = (uint32_t)c;
+            cnt[c]++;
+        }
+    }
+    /* cell starts; tcount becomes each chunk's next place in each cell */
+    size_t escaped = 0, k = 0;
+    for (int t = 0; t < nt; t++) escaped += esc[t];
+    for (size_t c = 0; c < ncells; c++) {
+        count[c] = k;
+        for (int t = 0; t < nt; t++) {
+            uint32_t *cnt = nb->tcount + (size_t)t * ncells;
+            const uint32_t m = cnt[c];
+            cnt[c] = (uint32_t)k;
+            k += m;
+        }
+    }
+    count[ncells] = k;
+#pragma omp parallel for schedule(static, 1) num_threads(nt) if (nt > 1)
+    for (int t = 0; t < nt; t++) {
+        uint32_t *next = nb->tcount + (size_t)t * ncells;
+        const size_t i0 = n * (size_t)t / (size_t)nt, i1 = n * (size_t)(t + 1) / (size_t)nt;
+        for (size_t i = i0; i < i1; i++) {
+            const size_t kk = next[nb->cell[i]]++;
+            double xi[3];
+            search_position(nb, x, i, xi);
+            nb->perm[kk] = (uint32_t)i;
+            nb->spos[i] = (uint32_t)kk;
+            for (int d = 0; d < dim; d++) nb->xs[d][kk] = xi[d];
+        }
     }
     nb->nescaped = escaped;
     return escaped;

@@ -79,7 +79,8 @@ typedef struct {
     uint32_t *spos;     /* [n] position of particle i in cell order */
     double *xs[3];      /* [n] positions (wrapped) in cell order */
     size_t *cell_start; /* [ncells + 1] */
-    size_t *cursor;     /* [ncells] */
+    uint32_t *tcount;   /* [threads x ncells] per-thread cell counts of the binning */
+    size_t cap_tcount;
     size_t cap_n, cap_pairs, cap_cells;
 
     /* sort order of lub_neighbours_order: rows of spacing order_h (0: cell order) */

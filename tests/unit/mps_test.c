@@ -431,6 +431,55 @@ static void test_order_3d(void)
     check_order(3);
 }
 
+/* The binning runs in chunks of particles on several threads once there are enough of
+ * them: its result is the serial counting sort's, a permutation stable by cell (checked
+ * here from the cells directly), the same with 1, 2 and 3 threads, escaped particles
+ * included. */
+static void test_bin_threads(void)
+{
+    const double lo[3] = {0, 0, 0}, hi[3] = {1.0, 0.5, 0};
+    const int per[3] = {1, 0, 0};
+    const size_t n = 20000;
+    cloud c;
+    cloud_init(&c, n);
+    size_t nesc = 0;
+    for (size_t k = 0; k < n; k++) {
+        double y = hi[1] * rnd();
+        if (k % 997 == 1) y = hi[1] + 0.05, nesc++;  /* escaped */
+        cloud_add(&c, 2.0 * rnd() - 0.5, y, 0.0, 0); /* x: periodic images too */
+    }
+    lub_neighbours a, b;
+    lub_neighbours_init(&a, 2, 0.02, 0.0, lo, hi, per);
+    lub_neighbours_init(&b, 2, 0.02, 0.0, lo, hi, per);
+    const int nt = omp_get_max_threads();
+    omp_set_num_threads(1);
+    const size_t ea = lub_neighbours_build(&a, n, c.x);
+    int same = 1;
+    for (int t = 2; t <= 3; t++) {
+        omp_set_num_threads(t);
+        const size_t eb = lub_neighbours_build(&b, n, c.x);
+        same &= ea == eb && a.npairs == b.npairs;
+        same &= memcmp(a.perm, b.perm, n * sizeof *a.perm) == 0;
+        same &= memcmp(a.cell, b.cell, n * sizeof *a.cell) == 0;
+        same &= memcmp(a.cell_start, b.cell_start, (a.ncells + 1) * sizeof *a.cell_start) == 0;
+        same &= memcmp(a.j, b.j, a.npairs * sizeof *a.j) == 0;
+    }
+    omp_set_num_threads(nt);
+    CHECK(same);
+    CHECK(ea == nesc);
+    int stable = 1;
+    for (size_t k = 1; k < n; k++) {
+        const uint32_t p = a.perm[k - 1], q = a.perm[k];
+        stable &= a.cell[p] < a.cell[q] || (a.cell[p] == a.cell[q] && p < q);
+    }
+    CHECK(stable);
+    CHECK(a.cell_start[a.ncells] == n);
+    CHECK(compare_brute(&b, &c, lo, hi, per) == 0);
+    lub_neighbours_free(&a);
+    lub_neighbours_free(&b);
+    cloud_free(&c);
+}
+
 /* Particles in random order sorted into cell order (lub_neighbours_order with h = 0, as
  * lubFoam does every step by default) and rebuilt: every list ascends in j (no periodic
  * direction, whose wrapped cells would come first), so the rows of a matrix assembled from
@@ -962,6 +1011,7 @@ int main(void)
     RUN(test_order_2d);
     RUN(test_order_3d);
     RUN(test_sorted_lists);
+    RUN(test_bin_threads);
     RUN(test_reference_2d);
     RUN(test_reference_3d);
     RUN(test_laplacian_lattice_2d);
