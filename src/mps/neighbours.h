@@ -38,7 +38,7 @@
  * outside [lo, hi) there are wrapped for the search (the caller's arrays are not modified).
  * Particles outside a non-periodic direction's [lo, hi] (or with a non-finite coordinate)
  * are clamped into the boundary cells: the search stays exact for them (clamping never
- * separates two particles closer than rs by more than one cell), only slower if many pile
+ * separates two particles closer than rs by more than two cells), only slower if many pile
  * up, and they are counted in the return value and in nb.nescaped so that the solver can
  * stop the run.  A particle with a NaN or infinite coordinate has no neighbours.
  *
@@ -51,6 +51,11 @@
 #include <stddef.h>
 #include <stdint.h>
 
+/* Cells are at least rs / LUB_NEIGHBOURS_REACH wide: every particle within rs of a point lies
+ * in the cells at most LUB_NEIGHBOURS_REACH cells away from the point's cell in each
+ * direction (a user of the cell grid, such as mps/opt.c, must look that far). */
+#define LUB_NEIGHBOURS_REACH 2
+
 typedef struct {
     int dim;   /* 2 or 3 */
     double re; /* effective radius of the weight */
@@ -61,7 +66,7 @@ typedef struct {
 
     /* cell grid (row-major, x fastest); unused directions have one cell */
     int nc[3];
-    double h[3], inv_h[3]; /* cell size >= rs */
+    double h[3], inv_h[3]; /* cell size >= rs / LUB_NEIGHBOURS_REACH */
     size_t ncells;
 
     /* results of the last build */

@@ -460,10 +460,11 @@ static int cell_of(const lub_neighbours *nb, int d, double x)
     return (int)t;
 }
 
-/* The cells of a cell list around x: cells[d][0 .. nc[d]) in direction d, up to 3 (fewer at
- * a non-periodic end, or when a period holds fewer than 3 cells). */
-static void cells_around(const lub_neighbours *nb, int dim, const double x[3], int cells[3][3],
-                         int nc[3])
+/* The cells of a cell list around x: cells[d][0 .. nc[d]) in direction d, up to
+ * 2 LUB_NEIGHBOURS_REACH + 1 (fewer at a non-periodic end, or when a period holds fewer). */
+#define CELLS_AROUND (2 * LUB_NEIGHBOURS_REACH + 1)
+static void cells_around(const lub_neighbours *nb, int dim, const double x[3],
+                         int cells[3][CELLS_AROUND], int nc[3])
 {
     for (int d = 0; d < 3; d++) {
         nc[d] = 0;
@@ -472,7 +473,7 @@ static void cells_around(const lub_neighbours *nb, int dim, const double x[3], i
             continue;
         }
         const int c = cell_of(nb, d, x[d]);
-        for (int off = -1; off <= 1; off++) {
+        for (int off = -LUB_NEIGHBOURS_REACH; off <= LUB_NEIGHBOURS_REACH; off++) {
             int cc = c + off;
             if (nb->periodic[d])
                 cc = (cc + nb->nc[d]) % nb->nc[d];
@@ -495,7 +496,7 @@ static inline size_t cell_index(const lub_neighbours *nb, int a, int b, int e)
  * particle within the list's radius of x); returns the count. */
 static size_t cells_collect(const lub_neighbours *nb, int dim, const double x[3], size_t *out)
 {
-    int cells[3][3], nc[3];
+    int cells[3][CELLS_AROUND], nc[3];
     cells_around(nb, dim, x, cells, nc);
     size_t n = 0;
     for (int a = 0; a < nc[0]; a++)

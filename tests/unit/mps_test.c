@@ -256,9 +256,14 @@ static void test_search_bad_input(void)
     CHECK_FATAL(lub_neighbours_init(&nb, 4, 0.1, 0.0, lo, hi, px), "dimension");
     const double hi_bad[3] = {1, 0, 1};
     CHECK_FATAL(lub_neighbours_init(&nb, 2, 0.1, 0.0, lo, hi_bad, px), "box in y");
-    /* a period of exactly 2 re is accepted */
+    /* a period of exactly 2 re is accepted, with complete lists (every image examined) */
     lub_neighbours_init(&nb, 2, 0.5, 0.0, lo, hi, px);
-    CHECK(nb.nc[0] == 2);
+    cloud c;
+    random_cloud(&c, 2, 300, lo, hi, px, 0.5);
+    lub_neighbours_build(&nb, c.n, c.x);
+    CHECK(nb.npairs > 0);
+    CHECK(compare_brute(&nb, &c, lo, hi, px) == 0);
+    cloud_free(&c);
     lub_neighbours_free(&nb);
 }
 
