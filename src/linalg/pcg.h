@@ -38,9 +38,10 @@
  *           MPS-like matrix).  With 1 block it is ic0.
  *   amg     one W-cycle (or V-cycle: options.cycle) of aggregation algebraic multigrid
  *           (amg.h): an iteration count that hardly grows with the particle count,
- *           block-parallel smoothing and aggregation.  The fastest
- *           here: 80k MPS-like unknowns to 1e-8 in 19 iterations, about 6 times faster than
- *           ic0 on 2 threads (tests/bench/linalg_bench.c).  If its coarsest matrix is not
+ *           block-parallel smoothing and aggregation.  The fastest here: 80k MPS-like
+ *           unknowns to 1e-8 in 12 iterations (W-cycle; 19 with the V-cycle), about 7
+ *           times faster than ic0 on 2 threads (tests/bench/linalg_bench.c, 2026-11-26:
+ *           92 ms against 666).  If its coarsest matrix is not
  *           positive definite, Jacobi is used and ic_shift = -1.
  * bic0 and amg iterate differently with a different number of threads (blocks).
  * With OpenMP (OMP_NUM_THREADS) SpMV, dot products and vector updates are parallel.
