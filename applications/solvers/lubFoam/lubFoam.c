@@ -160,13 +160,23 @@ static void print_header(const lubfoam_run *r)
         lub_message("MPS: l0 %g m, re %g m (%g l0), n0 %.10g, lambda0 %.10g m^2", m->l0, m->re,
                     m->c.re_l0, m->n0, m->lambda0);
     }
-    lub_message("Schemes: gradient %s%s, gamma %g, alpha %g, surface beta %g, viscosity %s",
+    char order[64];
+    if (m->c.reorder_interval == 1)
+        snprintf(order, sizeof order, "%s every step", m->c.order_rows ? "rows" : "cells");
+    else if (m->c.reorder_interval > 1)
+        snprintf(order, sizeof order, "%s every %d steps", m->c.order_rows ? "rows" : "cells",
+                 m->c.reorder_interval);
+    else
+        snprintf(order, sizeof order, "never");
+    lub_message("Schemes: gradient %s%s, gamma %g, alpha %g, surface beta %g, viscosity %s; "
+                "particles sorted into %s",
                 m->c.gradient == LUB_GRADIENT_LSMPS ? "lsmps" : "standard",
                 m->c.min_pressure_shift ? " (min-pressure shift)" : "", m->c.gamma, m->c.alpha,
                 m->c.beta,
                 m->c.viscosity == LUB_VISCOSITY_NONE       ? "none"
                 : m->c.viscosity == LUB_VISCOSITY_EXPLICIT ? "explicit"
-                                                           : "crankNicolson");
+                                                           : "crankNicolson",
+                order);
     lub_message("Solvers: p %s; U %s", ps, vs);
     /* the models of constant/models.yaml this run has (a scene enables only those it needs) */
     char models[1024];
