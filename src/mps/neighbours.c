@@ -12,11 +12,11 @@
 /* The cells are made this much (relative) larger than rs, so that the round-off of
  * (x - lo) / h never puts two particles closer than rs two cells apart. */
 #define CELL_MARGIN 1e-9
-/* Cells are at least rs / CELL_REACH wide, and a particle's candidates are those of the
- * (2 CELL_REACH + 1)^d cells around its own: with 2, 25 cells of rs / 2 in 2-D cover 6.25 rs^2
- * against 9 rs^2 for 9 cells of rs (31% fewer candidates for the same pairs). */
-#define CELL_REACH   LUB_NEIGHBOURS_REACH
-#define MAX_SEGMENTS ((2 * CELL_REACH + 1) * (2 * CELL_REACH + 1) * (2 * CELL_REACH + 1))
+/* Cells are at least rs / reach wide (neighbours.h), and a particle's candidates are those of
+ * the (2 reach + 1)^d cells around its own: with reach 2, 25 cells of rs / 2 in 2-D cover
+ * 6.25 rs^2 against 9 rs^2 for 9 cells of rs (31% fewer candidates for the same pairs). */
+#define R_MAX        LUB_NEIGHBOURS_MAX_REACH
+#define MAX_SEGMENTS ((2 * R_MAX + 1) * (2 * R_MAX + 1) * (2 * R_MAX + 1))
 /* Arrays grow with this headroom so that a slowly growing pair count does not reallocate
  * every step. */
 #define HEADROOM 1.25
@@ -38,8 +38,9 @@ void lub_neighbours_init(lub_neighbours *nb, int dim, double re, double skin, co
     lub_neighbours_set_box(nb, lo, hi, periodic);
 }
 
-void lub_neighbours_set_box(lub_neighbours *nb, const double lo[3], const double hi[3],
-                            const int periodic[3])
+/* The cell grid for cells at least rs / reach wide; returns the number of cells. */
+static double cell_grid(lub_neighbours *nb, const double lo[3], const double hi[3],
+                        const int periodic[3], int reach)
 {
     double ncells = 1.0;
     for (int d = 0; d < 3; d++) {
@@ -58,12 +59,13 @@ void lub_neighbours_set_box(lub_neighbours *nb, const double lo[3], const double
             lub_fatal("neighbour search: the period %g in %c is shorter than twice the search "
                       "radius 2 rs = %g",
                       L, axis_name[d], 2.0 * nb->rs);
-        double m = floor(L * CELL_REACH / (nb->rs * (1.0 + CELL_MARGIN)));
+        double m = floor(L * reach / (nb->rs * (1.0 + CELL_MARGIN)));
         if (m < 1) m = 1;
-        /* A period of at least 2 rs has at least 3 cells (cell_segments needs more cells
-         * than CELL_REACH in a periodic direction); just above 2 rs, every image is examined,
-         * so the missing margin does not matter. */
-        if (per && m < CELL_REACH + 1) m = CELL_REACH + 1;
+        /* A periodic direction has more cells than the reach (cell_segments wraps once), at
+         * least 2; just above 2 rs, every image is examined, so the missing margin does not
+         * matter. */
+        if (per && m < reach + 1) m = reach + 1;
+        if (per && m < 2) m = 2;
         if (m > 1e8) m = 1e8;
         nb->lo[d] = lo[d], nb->hi[d] = hi[d], nb->periodic[d] = per, nb->period[d] = L;
         nb->nc[d] = (int)m;
@@ -71,6 +73,17 @@ void lub_neighbours_set_box(lub_neighbours *nb, const double lo[3], const double
         nb->inv_h[d] = m / L;
         ncells *= m;
     }
+    nb->reach = reach;
+    return ncells;
+}
+
+void lub_neighbours_set_box(lub_neighbours *nb, const double lo[3], const double hi[3],
+                            const int periodic[3])
+{
+    /* cells of rs / 2, unless their grid would be very large (a big, sparsely filled box):
+     * then cells of rs, 2^d times fewer */
+    double ncells = cell_grid(nb, lo, hi, periodic, LUB_NEIGHBOURS_MAX_REACH);
+    if (ncells > LUB_NEIGHBOURS_FINE_CELLS_MAX) ncells = cell_grid(nb, lo, hi, periodic, 1);
     if (ncells > 4.0e9)
         lub_fatal("neighbour search: %.3g cells of size %g in the box, more than the 4e9 "
                   "supported: is the box much larger than the particles?",
@@ -331,7 +344,7 @@ static inline int add_cells(const lub_neighbours *nb, segment *seg, int ns, size
     return ns + 1;
 }
 
-/* The particles of the (2 CELL_REACH + 1)^d cells around cell c as at most MAX_SEGMENTS
+/* The particles of the (2 reach + 1)^d cells around cell c as at most MAX_SEGMENTS
  * segments: the cells of one row are contiguous in cell order, so a row is one run (two or
  * three across a periodic seam), usually 5 in 2-D and 25 in 3-D. */
 static int cell_segments(const lub_neighbours *nb, size_t c, segment *seg)
@@ -339,15 +352,16 @@ static int cell_segments(const lub_neighbours *nb, size_t c, segment *seg)
     const int nx = nb->nc[0], ny = nb->nc[1];
     const int cx = (int)(c % (size_t)nx), cy = (int)((c / (size_t)nx) % (size_t)ny);
     const int cz = (int)(c / ((size_t)nx * (size_t)ny));
-    const int oz = nb->dim == 3 ? CELL_REACH : 0;
-    const int xa = cx - CELL_REACH, xb = cx + CELL_REACH;
+    const int reach = nb->reach;
+    const int oz = nb->dim == 3 ? reach : 0;
+    const int xa = cx - reach, xb = cx + reach;
     const double L = nb->periodic[0] ? nb->period[0] : 0.0;
     int ns = 0;
     for (int dz = -oz; dz <= oz; dz++) {
         int z = cz + dz;
         double sz;
         if (!neighbour_coord(nb, 2, &z, &sz)) continue;
-        for (int dy = -CELL_REACH; dy <= CELL_REACH; dy++) {
+        for (int dy = -reach; dy <= reach; dy++) {
             int y = cy + dy;
             double sy;
             if (!neighbour_coord(nb, 1, &y, &sy)) continue;
@@ -357,7 +371,7 @@ static int cell_segments(const lub_neighbours *nb, size_t c, segment *seg)
                 ns = add_cells(nb, seg, ns, base, xa < 0 ? 0 : xa, xb >= nx ? nx - 1 : xb, s);
                 continue;
             }
-            /* periodic in x (nx >= 3 > CELL_REACH): the wrapped cells on the left, the row's
+            /* periodic in x (nx > reach): the wrapped cells on the left, the row's
              * own, the wrapped ones on the right, each with its shift */
             if (xa < 0) {
                 s[0] = -L;

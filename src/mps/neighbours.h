@@ -51,10 +51,12 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* Cells are at least rs / LUB_NEIGHBOURS_REACH wide: every particle within rs of a point lies
- * in the cells at most LUB_NEIGHBOURS_REACH cells away from the point's cell in each
- * direction (a user of the cell grid, such as mps/opt.c, must look that far). */
-#define LUB_NEIGHBOURS_REACH 2
+/* Cells are at least rs / reach wide (reach: 2, or 1 when cells of rs / 2 would number more
+ * than LUB_NEIGHBOURS_FINE_CELLS_MAX): every particle within rs of a point lies in the cells
+ * at most `reach` cells away from the point's cell in each direction (a user of the cell
+ * grid, such as mps/opt.c, must look that far). */
+#define LUB_NEIGHBOURS_MAX_REACH      2
+#define LUB_NEIGHBOURS_FINE_CELLS_MAX 16777216.0
 
 typedef struct {
     int dim;   /* 2 or 3 */
@@ -66,7 +68,8 @@ typedef struct {
 
     /* cell grid (row-major, x fastest); unused directions have one cell */
     int nc[3];
-    double h[3], inv_h[3]; /* cell size >= rs / LUB_NEIGHBOURS_REACH */
+    double h[3], inv_h[3]; /* cell size >= rs / reach */
+    int reach;             /* cells examined on each side (1 or LUB_NEIGHBOURS_MAX_REACH) */
     size_t ncells;
 
     /* results of the last build */

@@ -461,8 +461,8 @@ static int cell_of(const lub_neighbours *nb, int d, double x)
 }
 
 /* The cells of a cell list around x: cells[d][0 .. nc[d]) in direction d, up to
- * 2 LUB_NEIGHBOURS_REACH + 1 (fewer at a non-periodic end, or when a period holds fewer). */
-#define CELLS_AROUND (2 * LUB_NEIGHBOURS_REACH + 1)
+ * 2 reach + 1 (fewer at a non-periodic end, or when a period holds fewer). */
+#define CELLS_AROUND (2 * LUB_NEIGHBOURS_MAX_REACH + 1)
 static void cells_around(const lub_neighbours *nb, int dim, const double x[3],
                          int cells[3][CELLS_AROUND], int nc[3])
 {
@@ -473,7 +473,7 @@ static void cells_around(const lub_neighbours *nb, int dim, const double x[3],
             continue;
         }
         const int c = cell_of(nb, d, x[d]);
-        for (int off = -LUB_NEIGHBOURS_REACH; off <= LUB_NEIGHBOURS_REACH; off++) {
+        for (int off = -nb->reach; off <= nb->reach; off++) {
             int cc = c + off;
             if (nb->periodic[d])
                 cc = (cc + nb->nc[d]) % nb->nc[d];

@@ -485,6 +485,30 @@ static void test_bin_threads(void)
     cloud_free(&c);
 }
 
+/* Cells of rs / 2 (reach 2) unless their grid would exceed LUB_NEIGHBOURS_FINE_CELLS_MAX
+ * cells: then cells of rs (reach 1), 8 times fewer in 3-D; the lists are complete either way
+ * (a big, sparsely filled 3-D box: 260^3 half cells, 130^3 full ones). */
+static void test_cell_reach(void)
+{
+    const double lo[3] = {0, 0, 0}, small[3] = {0.1, 0.1, 0.1}, big[3] = {1.3, 1.3, 1.3};
+    const int none[3] = {0, 0, 0};
+    const double re = 0.01;
+    for (int t = 0; t < 2; t++) {
+        const double *hi = t ? big : small;
+        cloud c; /* the particles fill the small box (dense: about 30 neighbours each) */
+        random_cloud(&c, 3, 8000, lo, small, none, re);
+        lub_neighbours nb;
+        lub_neighbours_init(&nb, 3, re, 0.0, lo, hi, none);
+        CHECK(nb.reach == (t ? 1 : 2));
+        CHECK(t ? nb.ncells <= 131 * 131 * 131 : nb.nc[0] >= 19);
+        lub_neighbours_build(&nb, c.n, c.x);
+        CHECK(nb.npairs > 10 * c.n);
+        CHECK(compare_brute(&nb, &c, lo, hi, none) == 0);
+        lub_neighbours_free(&nb);
+        cloud_free(&c);
+    }
+}
+
 /* Particles in random order sorted into cell order (lub_neighbours_order with h = 0, as
  * lubFoam does every step by default) and rebuilt: every list ascends in j (no periodic
  * direction, whose wrapped cells would come first), so the rows of a matrix assembled from
@@ -1017,6 +1041,7 @@ int main(void)
     RUN(test_order_3d);
     RUN(test_sorted_lists);
     RUN(test_bin_threads);
+    RUN(test_cell_reach);
     RUN(test_reference_2d);
     RUN(test_reference_3d);
     RUN(test_laplacian_lattice_2d);
