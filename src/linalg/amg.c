@@ -246,12 +246,14 @@ int lub_amg_setup(lub_amg *g, const lub_csr *A)
             lv->b = lub_realloc(lv->b, (size_t)lv->n_cap * sizeof *lv->b);
             lv->x = lub_realloc(lv->x, (size_t)lv->n_cap * sizeof *lv->x);
             lv->tmp = lub_realloc(lv->tmp, (size_t)lv->n_cap * sizeof *lv->tmp);
-            lv->r2 = lub_realloc(lv->r2, (size_t)lv->n_cap * sizeof *lv->r2);
-            lv->e2 = lub_realloc(lv->e2, (size_t)lv->n_cap * sizeof *lv->e2);
+            if (l > 0) { /* the W-cycle repeats the cycles of the coarse levels only */
+                lv->r2 = lub_realloc(lv->r2, (size_t)lv->n_cap * sizeof *lv->r2);
+                lv->e2 = lub_realloc(lv->e2, (size_t)lv->n_cap * sizeof *lv->e2);
+            }
         }
-        smoother_values(lv);
         g->nlev = l + 1;
         if (n <= g->coarse_max) return coarse_factor(g, M);
+        smoother_values(lv); /* every level but a dense coarsest one is smoothed */
         grow_int(&lv->agg, &lv->agg_cap, n);
         lv->nc = aggregate(M, g->theta, lv->agg, g->nblocks);
         if (lv->nc > 0.9 * n || l == LUB_AMG_MAX_LEVELS - 1) {
@@ -334,7 +336,7 @@ static void gs_sweep(lub_amg *g, lub_amg_level *lv, const double *b, double *x, 
     }
 }
 
-/* res = b - A x, with the values vf (the smoother's, or the level's own) */
+/* res = b - A x, with the level's single-precision values vf (those its smoother uses) */
 static void residual(const lub_csr *A, const float *vf, const double *b, const double *x,
                      double *res)
 {

@@ -20,6 +20,8 @@
 /* Arrays grow with this headroom so that a slowly growing pair count does not reallocate
  * every step. */
 #define HEADROOM 1.25
+/* The binning runs on several threads from this many particles on. */
+#define BIN_PARALLEL_MIN 4096
 
 static const char axis_name[3] = {'x', 'y', 'z'};
 
@@ -61,11 +63,9 @@ static double cell_grid(lub_neighbours *nb, const double lo[3], const double hi[
                       L, axis_name[d], 2.0 * nb->rs);
         double m = floor(L * reach / (nb->rs * (1.0 + CELL_MARGIN)));
         if (m < 1) m = 1;
-        /* A periodic direction has more cells than the reach (cell_segments wraps once), at
-         * least 2; just above 2 rs, every image is examined, so the missing margin does not
-         * matter. */
+        /* A periodic direction has more cells than the reach (cell_segments wraps once); just
+         * above 2 rs, every image is examined, so the missing margin does not matter. */
         if (per && m < reach + 1) m = reach + 1;
-        if (per && m < 2) m = 2;
         if (m > 1e8) m = 1e8;
         nb->lo[d] = lo[d], nb->hi[d] = hi[d], nb->periodic[d] = per, nb->period[d] = L;
         nb->nc[d] = (int)m;
@@ -220,7 +220,7 @@ size_t lub_neighbours_bin(lub_neighbours *nb, size_t n, double *const x[3])
     const size_t ncells = nb->ncells;
     int nt = omp_get_max_threads();
     if (nt > 64) nt = 64;
-    if (n < 4096 || ncells > n) nt = 1;
+    if (n < BIN_PARALLEL_MIN || ncells > n) nt = 1;
     if ((size_t)nt * ncells > nb->cap_tcount) {
         free(nb->tcount);
         nb->cap_tcount = (size_t)nt * ncells;
