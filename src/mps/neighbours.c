@@ -407,6 +407,8 @@ static void count_sweep(lub_neighbours *nb)
     const int dim = nb->dim;
     const double rs2 = nb->rs * nb->rs;
     const double *const xs[3] = {nb->xs[0], nb->xs[1], nb->xs[2]};
+    const uint8_t *lk = nb->list_kind;
+    const unsigned kinds = nb->list_kinds;
 #pragma omp parallel
     {
         segment seg[MAX_SEGMENTS];
@@ -414,6 +416,10 @@ static void count_sweep(lub_neighbours *nb)
         size_t last_cell = (size_t)-1;
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
+            if (lk && !(kinds >> lk[i] & 1u)) {
+                nb->start[i + 1] = 0;
+                continue;
+            }
             const size_t c = nb->cell[i], ki = nb->spos[i];
             if (c != last_cell) ns = cell_segments(nb, c, seg), last_cell = c;
             const double xi[3] = {xs[0][ki], xs[1][ki], dim == 3 ? xs[2][ki] : 0.0};
@@ -456,11 +462,12 @@ static void fill_sweep(lub_neighbours *nb)
         size_t last_cell = (size_t)-1;
 #pragma omp for schedule(static)
         for (size_t i = 0; i < n; i++) {
+            const size_t end = nb->start[i + 1];
+            size_t m = nb->start[i];
+            if (m == end) continue; /* no list wanted (or no neighbours) */
             const size_t c = nb->cell[i], ki = nb->spos[i];
             if (c != last_cell) ns = cell_segments(nb, c, seg), last_cell = c;
             const double xi[3] = {xs[0][ki], xs[1][ki], dim == 3 ? xs[2][ki] : 0.0};
-            const size_t end = nb->start[i + 1];
-            size_t m = nb->start[i];
             for (int s = 0; s < ns; s++) {
                 const double p[3] = {seg[s].s[0] - xi[0], seg[s].s[1] - xi[1], seg[s].s[2] - xi[2]};
                 const size_t ms = m;

@@ -42,6 +42,8 @@
  * up, and they are counted in the return value and in nb.nescaped so that the solver can
  * stop the run.  A particle with a NaN or infinite coordinate has no neighbours.
  *
+ * Lists of some particles only: set nb.list_kind (a kind per particle, e.g. P->kind) and
+ * nb.list_kinds (a bit per kind) before the build; the others get empty lists.
  * OpenMP over particles; the lists do not depend on the number of threads.
  */
 #ifndef LUB_MPS_NEIGHBOURS_H
@@ -81,6 +83,13 @@ typedef struct {
     double *w;       /* [npairs] w(|r_ij|, re) */
     uint32_t *perm;  /* [n] cell order: perm[k] = index of the k-th particle */
     size_t nescaped; /* particles outside the box in a non-periodic direction, or non-finite */
+
+    /* whose lists are built (set before a build; list_kind NULL: every particle's): particle
+     * i gets its list when bit list_kind[i] of list_kinds is set, otherwise an empty one.
+     * It still appears in the others' lists.  The solver leaves out the dummy particles',
+     * which nothing reads (a fifth of the particles in the wedge). */
+    const uint8_t *list_kind;
+    unsigned list_kinds;
 
     /* internal */
     uint32_t *cell;     /* [n] cell of particle i */

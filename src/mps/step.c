@@ -141,6 +141,10 @@ static void neighbours(lub_mps *m, int rebuild)
     lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
     if (!rebuild && lub_neighbours_update(&m->nb, x) != 0) rebuild = 1;
     if (rebuild) {
+        /* nothing reads a dummy particle's own list (its PND, velocity or pressure is never
+         * formed; it enters the others' sums as their neighbour) */
+        m->nb.list_kind = P->kind;
+        m->nb.list_kinds = K_FLUID | K_WALL;
         lub_neighbours_build(&m->nb, P->n, x);
         m->st.nrebuild++;
     }
@@ -745,16 +749,21 @@ static long through_wall(const lub_mps *m, double dt, unsigned *patch, double *t
     const double g2 = THROUGH_GATE * THROUGH_GATE * m->l0 * m->l0;
     const long none = (long)P->n;
     long first = none;
+    /* from the fluid side (the dummies have no lists of their own): each fluid particle near
+     * a dummy of a patch, tested against that patch */
 #pragma omp parallel for schedule(static) reduction(min : first)
-    for (size_t d = 0; d < P->n; d++) {
-        if (P->kind[d] != LUB_DUMMY) continue;
-        for (size_t q = nb->start[d]; q < nb->start[d + 1]; q++) {
-            const size_t i = nb->j[q];
-            if (P->kind[i] != LUB_FLUID || (long)i >= first) continue;
-            if (m->fixed && m->fixed[i]) continue; /* given: lub_mps_buried */
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->kind[i] != LUB_FLUID || (long)i >= first) continue;
+        if (m->fixed && m->fixed[i]) continue; /* given: lub_mps_buried */
+        for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+            const size_t d = nb->j[q];
+            if (P->kind[d] != LUB_DUMMY) continue;
             if (!(lub_neighbours_r(nb, x, d, i, NULL) < g2)) continue;
             double a, b;
-            if (through(m, dt, i, P->patch[d], &a, &b)) first = (long)i;
+            if (through(m, dt, i, P->patch[d], &a, &b)) {
+                first = (long)i;
+                break;
+            }
         }
     }
     if (first == none) return -1;
@@ -776,16 +785,20 @@ size_t lub_mps_buried(const lub_mps *m, double dt, uint8_t *flag)
     memset(flag, 0, P->n);
     if (!m->fixed) return 0;
     size_t n = 0;
-    /* serial: a fluid particle may be a neighbour of several dummies */
-    for (size_t d = 0; d < P->n; d++) {
-        if (P->kind[d] != LUB_DUMMY) continue;
-        for (size_t q = nb->start[d]; q < nb->start[d + 1]; q++) {
-            const size_t i = nb->j[q];
-            if (P->kind[i] != LUB_FLUID || !m->fixed[i] || flag[i]) continue;
+    /* from the fluid side (the dummies have no lists of their own) */
+#pragma omp parallel for schedule(static) reduction(+ : n)
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->kind[i] != LUB_FLUID || !m->fixed[i]) continue;
+        for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+            const size_t d = nb->j[q];
+            if (P->kind[d] != LUB_DUMMY) continue;
             if (!(lub_neighbours_r(nb, x, d, i, NULL) < g2)) continue;
             double a = 0, b = 0;
             through(m, dt, i, P->patch[d], &a, &b);
-            if (b > THROUGH_DEPTH * m->l0) flag[i] = 1, n++;
+            if (b > THROUGH_DEPTH * m->l0) {
+                flag[i] = 1, n++;
+                break;
+            }
         }
     }
     return n;

@@ -7,6 +7,7 @@
 #include <string.h>
 
 #include "mps/neighbours.h"
+#include "particles/particles.h"
 #include "mps/operators.h"
 #include "mps/weight.h"
 #include "test.h"
@@ -499,6 +500,57 @@ static void test_bin_threads(void)
 /* Cells of rs / 2 (reach 2) unless their grid would exceed LUB_NEIGHBOURS_FINE_CELLS_MAX
  * cells: then cells of rs (reach 1), 8 times fewer in 3-D; the lists are complete either way
  * (a big, sparsely filled 3-D box: 260^3 half cells, 130^3 full ones). */
+/* Lists of some kinds only (list_kind, list_kinds): a particle of another kind gets an empty
+ * list and stays in the others'; the lists built are those of a full build, entry for entry
+ * (the full build is itself checked against brute force above). */
+static void check_list_kinds(int dim, const int per[3])
+{
+    const double lo[3] = {0, 0, 0}, hi[3] = {1.0, 0.6, 0.4}, re = 0.08;
+    cloud c;
+    random_cloud(&c, dim, dim == 2 ? 3000 : 6000, lo, hi, per, re);
+    for (size_t i = 0; i < c.n; i++) c.kind[i] = (uint8_t)(rnd() * 3); /* fluid, wall, dummy */
+    lub_neighbours full, part;
+    lub_neighbours_init(&full, dim, re, 0.0, lo, hi, per);
+    lub_neighbours_init(&part, dim, re, 0.0, lo, hi, per);
+    lub_neighbours_build(&full, c.n, c.x);
+    part.list_kind = c.kind;
+    part.list_kinds = LUB_MPS_KIND(LUB_FLUID) | LUB_MPS_KIND(LUB_WALL);
+    lub_neighbours_build(&part, c.n, c.x);
+    size_t bad = 0, pairs = 0, ndummy = 0;
+    for (size_t i = 0; i < c.n; i++) {
+        const size_t nf = full.start[i + 1] - full.start[i], np = part.start[i + 1] - part.start[i];
+        if (c.kind[i] == LUB_DUMMY) {
+            ndummy++;
+            bad += np != 0;
+            continue;
+        }
+        pairs += nf;
+        if (np != nf) {
+            bad++;
+            continue;
+        }
+        for (size_t m = 0; m < nf; m++) {
+            const size_t a = full.start[i] + m, b = part.start[i] + m;
+            int same = full.j[a] == part.j[b] && full.w[a] == part.w[b];
+            for (int d = 0; d < dim; d++) same &= full.dx[d][a] == part.dx[d][b];
+            bad += !same;
+        }
+    }
+    CHECK(ndummy > c.n / 4 && bad == 0 && part.npairs == pairs && pairs < full.npairs);
+    printf("  %d-D: %zu particles, %zu dummies: %zu pairs instead of %zu, the rest identical\n",
+           dim, c.n, ndummy, part.npairs, full.npairs);
+    lub_neighbours_free(&full);
+    lub_neighbours_free(&part);
+    cloud_free(&c);
+}
+
+static void test_list_kinds(void)
+{
+    const int px[3] = {1, 0, 0}, none[3] = {0, 0, 0};
+    check_list_kinds(2, px);
+    check_list_kinds(3, none);
+}
+
 static void test_cell_reach(void)
 {
     const double lo[3] = {0, 0, 0}, small[3] = {0.1, 0.1, 0.1}, big[3] = {1.3, 1.3, 1.3};
@@ -1051,6 +1103,7 @@ int main(void)
     RUN(test_sorted_lists);
     RUN(test_bin_threads);
     RUN(test_cell_reach);
+    RUN(test_list_kinds);
     RUN(test_reference_2d);
     RUN(test_reference_3d);
     RUN(test_laplacian_lattice_2d);
