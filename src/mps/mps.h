@@ -10,6 +10,8 @@
  *     4. PND n* at r*                              (T-11)
  *     5. free surface: n* < beta n0, refined by a geometric test   (T-12)
  *     6. pressure Poisson equation                 (T-9, T-10), Dirichlet p = 0 on the surface
+ *        (with alpha = 0 also on a group of particles that touches no surface particle: its
+ *        pressure would be undetermined; st.nisolated)
  *     7. pressure gradient                         standard (T-13, T-14) or LSMPS (T-15)
  *     8. u^{k+1} = u* - dt/rho grad p, r^{k+1} = r* + (u^{k+1} - u*) dt   (T-16, T-17)
  *     9. collision, periodic wrap, checks (non-finite values, the domain box, a fluid
@@ -111,7 +113,10 @@ void lub_mps_config_read(lub_mps_config *c, const char *case_dir, const lub_part
 typedef struct {
     lub_solve_result p, v[3];
     size_t nsurface, nunknowns, nfallback, nrebuild;
-    double umax; /* largest fluid speed after the step */
+    size_t nisolated;               /* particles of groups touching no Dirichlet particle, taken as
+                                       surface after a failed pressure solve (step.c, pressure) */
+    unsigned long long isolated_id; /* the id of the first of them */
+    double umax;                    /* largest fluid speed after the step */
 } lub_mps_stats;
 
 /* Phases timed in every run (cost.dat columns). */
@@ -143,6 +148,8 @@ typedef struct {
     double *us[3]; /* u* */
     double *pnd;   /* n* */
     uint8_t *surface;
+    uint8_t *anchor;       /* pressure row next to a Dirichlet particle (step.c, isolated_groups) */
+    int nlattice;          /* lattice neighbours within re (2-D: 28 at re = 3.1 l0, 12 at 2.1) */
     int *row;              /* unknown index of a particle, -1 */
     int *prow;             /* particle of an unknown */
     double *b, *x;         /* right-hand side and solution (pressure) */

@@ -72,6 +72,17 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
     m->b = alloc_doubles(n);
     m->x = alloc_doubles(n);
     m->surface = lub_calloc(n ? n : 1, 1);
+    m->anchor = lub_calloc(n ? n : 1, 1);
+    {
+        const int h = (int)ceil(m->re / m->l0), hz = m->dim == 3 ? h : 0;
+        m->nlattice = 0;
+        for (int a = -h; a <= h; a++)
+            for (int b = -h; b <= h; b++)
+                for (int c3 = -hz; c3 <= hz; c3++) {
+                    const double r = m->l0 * sqrt((double)(a * a + b * b + c3 * c3));
+                    if (r > 0 && r < m->re) m->nlattice++;
+                }
+    }
     m->row = lub_calloc(n ? n : 1, sizeof *m->row);
     m->prow = lub_calloc(n ? n : 1, sizeof *m->prow);
     m->scratch = lub_malloc((n ? n : 1) * sizeof(double));
@@ -93,6 +104,7 @@ void lub_mps_free(lub_mps *m)
     free(m->b);
     free(m->x);
     free(m->surface);
+    free(m->anchor);
     free(m->row);
     free(m->prow);
     free(m->scratch);
@@ -385,6 +397,60 @@ static void free_surface(lub_mps *m)
  * pressure, b_i + c sum_j w_ij P_j > 0 (the multiplier changes sign).  In a steady flow the
  * set settles to the complementarity solution; each step costs one solve, as with clip.
  * The set is the particle field "cavitation" (saved with the particles: exact restart). */
+/* Groups of pressure unknowns connected, through the matrix, to no Dirichlet particle (a
+ * surface, cavitation-held or given-pressure neighbour within re): particles squeezed together
+ * apart from the rest, whose PND is above the surface threshold, so that none of them is a
+ * surface particle.  With alpha = 0 their pressure is undetermined (their rows sum to zero:
+ * the matrix is singular), and the solve fails.  Such a group is small and its particles have
+ * few neighbours, so the search starts only from the rows with fewer than half the lattice's
+ * neighbours and no Dirichlet one (m->anchor, from the assembly), and explores at most
+ * ISOLATED_MAX rows from each (more: taken as connected, as a large group has a surface of its
+ * own).  Marks the particles of each group found as surface particles and returns their
+ * number.  Costs one pass over the rows when there is no such candidate (the usual case). */
+#define ISOLATED_MAX 256
+static size_t isolated_groups(lub_mps *m, int nu)
+{
+    const lub_particles *P = m->P;
+    const lub_csr *A = &m->A;
+    /* state of a row: 0 not seen, -1 connected, k > 0 seen by the search from row k - 1;
+     * and the search's queue: 2 nu ints within the scratch's n doubles */
+    int *state = m->scratch, *queue = state + nu;
+    memset(state, 0, (size_t)nu * sizeof *state);
+    const int few = m->nlattice / 2;
+    size_t count = 0;
+    for (int r = 0; r < nu; r++) {
+        if (state[r] || m->anchor[r] || A->row_ptr[r + 1] - A->row_ptr[r] - 1 >= few) continue;
+        const int mark = r + 1;
+        int head = 0, tail = 0, connected = 0;
+        state[r] = mark;
+        queue[tail++] = r;
+        while (head < tail && !connected) {
+            const int s = queue[head++];
+            if (m->anchor[s] || tail > ISOLATED_MAX) {
+                connected = 1;
+                break;
+            }
+            for (int k = A->row_ptr[s]; k < A->row_ptr[s + 1]; k++) {
+                const int c = A->col[k];
+                if (state[c] == -1) {
+                    connected = 1;
+                    break;
+                }
+                if (state[c] != mark) state[c] = mark, queue[tail++] = c;
+            }
+        }
+        for (int t = 0; t < tail; t++) state[queue[t]] = -1;
+        if (connected) continue;
+        for (int t = 0; t < tail; t++) { /* the whole group, explored: no Dirichlet row */
+            const size_t i = (size_t)m->prow[queue[t]];
+            if (count == 0) m->st.isolated_id = (unsigned long long)P->id[i];
+            m->surface[i] = 1;
+            count++;
+        }
+    }
+    return count;
+}
+
 static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
 {
     lub_particles *P = m->P;
@@ -398,6 +464,11 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
      * a level's region means nothing); it enters the rows of its neighbours as c w_ij P_j */
     const uint8_t *fix = m->fixed;
 
+    /* groups touching no Dirichlet particle would make the matrix singular
+     * (isolated_groups): they are taken as surface particles (p = 0), and the matrix is
+     * assembled again */
+    int retried = 0;
+assemble:
     lub_timer_start(&m->tm, LUB_T_ASSEMBLY);
     int nu = 0;
     size_t nfix = 0;
@@ -424,6 +495,7 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
         double *val = lub_csr_row_val(&m->A, r);
         double wsum = 0, bfix = 0;
         int e = 0, dg = -1; /* the diagonal in column order (the lists are sorted) */
+        uint8_t anchored = 0;
         for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
             double w = nb->w[q];
             size_t j = nb->j[q];
@@ -433,10 +505,12 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
                 if (dg < 0 && m->row[j] > r) dg = e++;
                 col[e] = m->row[j];
                 val[e++] = -c * w;
-            } else if (fix && fix[j]) {
-                bfix += w * P->p[j];
+            } else {
+                anchored = 1; /* a Dirichlet neighbour */
+                if (fix && fix[j]) bfix += w * P->p[j];
             }
         }
+        m->anchor[r] = anchored;
         if (dg < 0) dg = e;
         col[dg] = r;
         val[dg] = c * wsum + alpha;
@@ -445,6 +519,16 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
         m->x[r] = P->p[i]; /* warm start from the previous pressure */
     }
     lub_csr_finish(&m->A);
+    if (alpha == 0 && !retried) {
+        const size_t k = isolated_groups(m, nu);
+        if (k > 0) {
+            m->st.nisolated = k;
+            m->st.nsurface += k;
+            retried = 1;
+            lub_timer_stop(&m->tm, LUB_T_ASSEMBLY);
+            goto assemble;
+        }
+    }
     lub_timer_stop(&m->tm, LUB_T_ASSEMBLY);
 
     lub_timer_start(&m->tm, LUB_T_PSOLVE);

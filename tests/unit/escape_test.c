@@ -16,7 +16,9 @@
  *
  * Then through lub_mps_step: a particle driven into the wall stops the step with
  * LUB_STEP_ESCAPED, and a sheared channel with collisions and a fluid pressed onto the lower
- * wall by gravity run without a false alarm.
+ * wall by gravity run without a false alarm.  Last, a related failure that is not an escape:
+ * particles squeezed into a group apart from the rest, which touches no surface particle and
+ * makes the pressure equation singular (test_isolated_group).
  */
 #include <math.h>
 #include <stdlib.h>
@@ -397,6 +399,83 @@ static void test_step_no_alarm(void)
     }
 }
 
+/* A pool on a plane under gravity with a free surface (alpha = 0), re = 2.1 l0, and four of its
+ * fluid particles moved far above it: squeezed together (a square of side 0.4 l0) they see only
+ * each other, their PND is above the surface threshold, so none is a surface particle, and
+ * the pressure equation is singular on them (their rows sum to zero).  The step takes them as
+ * surface particles (st.nisolated = 4, p = 0) and gives the pool the pressure it gets when the
+ * four are far apart instead (each alone: a surface particle by its PND), to round-off. */
+static const char *pool2 = "dimension: 2\n"
+                           "l0: 0.001\n"
+                           "domain: { min: [0, -0.004], max: [0.03, 0.03] }\n"
+                           "dummyLayers: 2\n"
+                           "walls:\n"
+                           "  lower: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+                           "fluid:\n"
+                           "  - { type: box, min: [0.002, 0], max: [0.018, 0.008] }\n";
+
+static void pool_step(int squeezed, scene *s, size_t moved[4], lub_step_status *st, char *msg,
+                      size_t msgsize)
+{
+    memset(s, 0, sizeof *s);
+    generate(pool2, &s->P, &s->g);
+    lub_mps_config c;
+    lub_mps_config_defaults(&c);
+    c.rho = 1000;
+    c.nu = 1e-6;
+    c.viscosity = LUB_VISCOSITY_CN;
+    c.alpha = 0;
+    c.re_l0 = 2.1;
+    c.gravity = 1, c.g[1] = -9.81; /* a pressure in the pool */
+    c.clip_negative = LUB_NEGATIVE_KEEP;
+    c.reorder_interval = 0; /* particle indices stay put */
+    lub_mps_init(&s->m, &s->P, &c, s->g.dmin, s->g.dmax, s->g.periodic);
+    s->l0 = s->P.levels[0].l0;
+    s->dt = 1e-3;
+    /* the four fluid particles nearest the pool's upper right corner, moved to (0.022, 0.02) */
+    const double corner[3] = {0.0175, 0.0075, 0};
+    for (int k = 0; k < 4; k++) {
+        moved[k] = fluid_near(s, corner);
+        const double a = squeezed ? 0.4 * s->l0 : 5 * s->l0;
+        s->P.x[0][moved[k]] = 0.022 + a * (k % 2);
+        s->P.x[1][moved[k]] = 0.020 + a * (k / 2);
+    }
+    long bad;
+    *st = lub_mps_step(&s->m, s->dt, &bad, msg, msgsize);
+}
+
+static void test_isolated_group(void)
+{
+    scene a, b;
+    size_t ma[4], mb[4];
+    lub_step_status sa, sb;
+    char msg[512] = "";
+    pool_step(1, &a, ma, &sa, msg, sizeof msg);
+    if (sa != LUB_STEP_OK) printf("  squeezed: %s\n", msg);
+    pool_step(0, &b, mb, &sb, msg, sizeof msg);
+    if (sb != LUB_STEP_OK) printf("  apart: %s\n", msg);
+    CHECK(sa == LUB_STEP_OK && sb == LUB_STEP_OK);
+    CHECK(a.m.st.nisolated == 4 && b.m.st.nisolated == 0);
+    CHECK(a.P.n == b.P.n && memcmp(ma, mb, sizeof ma) == 0);
+    int clump_zero = 1;
+    for (int k = 0; k < 4; k++) clump_zero &= a.P.p[ma[k]] == 0.0 && a.m.surface[ma[k]];
+    CHECK(clump_zero);
+    double dmax = 0, pmax = 0;
+    size_t npool = 0;
+    for (size_t i = 0; i < a.P.n; i++) {
+        if (a.P.kind[i] != LUB_FLUID || i == ma[0] || i == ma[1] || i == ma[2] || i == ma[3])
+            continue;
+        dmax = fmax(dmax, fabs(a.P.p[i] - b.P.p[i]));
+        pmax = fmax(pmax, fabs(b.P.p[i]));
+        npool++;
+    }
+    printf("  pool of %zu particles: pressure up to %.3g Pa, largest difference %.3g Pa\n", npool,
+           pmax, dmax);
+    CHECK(pmax > 0 && dmax <= 1e-9 * pmax);
+    scene_close(&a);
+    scene_close(&b);
+}
+
 int main(void)
 {
     RUN(test_plane_through);
@@ -406,5 +485,6 @@ int main(void)
     RUN(test_cylinder);
     RUN(test_step_escape);
     RUN(test_step_no_alarm);
+    RUN(test_isolated_group);
     return test_summary();
 }

@@ -444,7 +444,7 @@ int main(int argc, char **argv)
     const long step0 = r.step;
     long steps = 0, last_write_step = -1;
     double pit_sum = 0, vit_sum = 0, last_bar = 0;
-    int warned_courant = 0, warned_full = 0, status = LUB_EXIT_OK;
+    int warned_courant = 0, warned_full = 0, warned_isolated = 0, status = LUB_EXIT_OK;
 
     /* multi-resolution with sub-stepping: one pass of the loop is one step of the coarsest
      * level, nr steps of deltaT (dt below) on the finest level (nr: the product of the Nr) */
@@ -519,6 +519,17 @@ int main(int argc, char **argv)
             vit_sum += viscosity_iterations(&r.mps);
             co = r.mps.st.umax * r.dt / r.mps.l0;
             umax = r.mps.st.umax;
+        }
+        for (int k = 0; k < (r.opt ? r.opt->nlevels : 1) && !warned_isolated; k++) {
+            const lub_mps *mk = r.opt ? &r.opt->m[k] : &r.mps;
+            if (mk->st.nisolated > 0) {
+                lub_warning("step %ld: %zu particle(s) squeezed into groups that touch no "
+                            "surface particle (first: id %llu), where the pressure equation "
+                            "(alpha = 0) is singular: taken as surface particles (p = 0), "
+                            "now and whenever it happens again (warned once)",
+                            r.step, mk->st.nisolated, mk->st.isolated_id);
+                warned_isolated = 1;
+            }
         }
         if (!r.ctl.adjust_time_step && co > r.ctl.max_courant && !warned_courant) {
             lub_warning("step %ld: Courant number %.3g exceeds maxCourant %g (u_max %g m/s)",
