@@ -114,7 +114,7 @@ typedef struct {
     lub_solve_result p, v[3];
     size_t nsurface, nunknowns, nfallback, nrebuild;
     size_t nisolated;               /* particles of groups touching no Dirichlet particle, taken as
-                                       surface after a failed pressure solve (step.c, pressure) */
+                                       surface particles (step.c, isolated_groups) */
     unsigned long long isolated_id; /* the id of the first of them */
     double umax;                    /* largest fluid speed after the step */
 } lub_mps_stats;

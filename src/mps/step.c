@@ -380,23 +380,6 @@ static void free_surface(lub_mps *m)
     m->st.nsurface = ns;
 }
 
-/* Pressure Poisson equation (T-9, T-10), negated so that the matrix is symmetric positive
- * definite: c sum_j w_ij (P_i - P_j) + alpha P_i = gamma rho / dt^2 (n*_i - n0) / n0,
- * c = 2d / (lambda0 n0), over fluid and wall particles; surface particles are Dirichlet
- * (P = 0), dummy particles carry no pressure.
- *
- * Negative pressure (schemes.yaml negativePressure): `keep`; `clip`, set to 0 after the solve
- * (the thesis); or `cavitation`, the complementarity condition P >= 0, (A P - b)_i >= 0,
- * P_i (A P - b)_i = 0 of a liquid that cannot carry tension, which is what the Reynolds
- * boundary condition (p = dp/dx = 0 at the film's rupture) expresses for a film.  Clipping
- * after the solve is not that: the solve still pulls the pressure near the rupture down
- * towards the negative values it finds past it, and the film's pressure falls to zero before
- * the Reynolds exit.  The condition is met by an active set lagged by one step: a particle
- * whose solved pressure was negative is held at P = 0 (a Dirichlet particle, like a surface
- * particle) from the next step on, and released when its row would give it a positive
- * pressure, b_i + c sum_j w_ij P_j > 0 (the multiplier changes sign).  In a steady flow the
- * set settles to the complementarity solution; each step costs one solve, as with clip.
- * The set is the particle field "cavitation" (saved with the particles: exact restart). */
 /* Groups of pressure unknowns connected, through the matrix, to no Dirichlet particle (a
  * surface, cavitation-held or given-pressure neighbour within re): particles squeezed together
  * apart from the rest, whose PND is above the surface threshold, so that none of them is a
@@ -451,6 +434,23 @@ static size_t isolated_groups(lub_mps *m, int nu)
     return count;
 }
 
+/* Pressure Poisson equation (T-9, T-10), negated so that the matrix is symmetric positive
+ * definite: c sum_j w_ij (P_i - P_j) + alpha P_i = gamma rho / dt^2 (n*_i - n0) / n0,
+ * c = 2d / (lambda0 n0), over fluid and wall particles; surface particles are Dirichlet
+ * (P = 0), dummy particles carry no pressure.
+ *
+ * Negative pressure (schemes.yaml negativePressure): `keep`; `clip`, set to 0 after the solve
+ * (the thesis); or `cavitation`, the complementarity condition P >= 0, (A P - b)_i >= 0,
+ * P_i (A P - b)_i = 0 of a liquid that cannot carry tension, which is what the Reynolds
+ * boundary condition (p = dp/dx = 0 at the film's rupture) expresses for a film.  Clipping
+ * after the solve is not that: the solve still pulls the pressure near the rupture down
+ * towards the negative values it finds past it, and the film's pressure falls to zero before
+ * the Reynolds exit.  The condition is met by an active set lagged by one step: a particle
+ * whose solved pressure was negative is held at P = 0 (a Dirichlet particle, like a surface
+ * particle) from the next step on, and released when its row would give it a positive
+ * pressure, b_i + c sum_j w_ij P_j > 0 (the multiplier changes sign).  In a steady flow the
+ * set settles to the complementarity solution; each step costs one solve, as with clip.
+ * The set is the particle field "cavitation" (saved with the particles: exact restart). */
 static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
 {
     lub_particles *P = m->P;

@@ -41,21 +41,33 @@ typedef struct {
     double l0, dt;
 } scene;
 
-static void scene_open(scene *s, const char *dict, int collision)
+/* The particles of dict and the scenes' solver settings (water, Crank-Nicolson viscosity,
+ * particle indices kept: no sorting) in *c, for the caller to adjust before scene_solver. */
+static void scene_particles(scene *s, const char *dict, lub_mps_config *c)
 {
     memset(s, 0, sizeof *s);
     generate(dict, &s->P, &s->g);
-    lub_mps_config c;
-    lub_mps_config_defaults(&c);
-    c.rho = 1000;
-    c.nu = 1e-6;
-    c.viscosity = LUB_VISCOSITY_CN;
-    c.alpha = 1e-6 / (s->P.levels[0].l0 * s->P.levels[0].l0); /* closed channels */
-    c.reorder_interval = 0;                                   /* particle indices stay put */
-    c.collision = collision;
-    lub_mps_init(&s->m, &s->P, &c, s->g.dmin, s->g.dmax, s->g.periodic);
+    lub_mps_config_defaults(c);
+    c->rho = 1000;
+    c->nu = 1e-6;
+    c->viscosity = LUB_VISCOSITY_CN;
+    c->reorder_interval = 0;
+}
+
+static void scene_solver(scene *s, const lub_mps_config *c)
+{
+    lub_mps_init(&s->m, &s->P, c, s->g.dmin, s->g.dmax, s->g.periodic);
     s->l0 = s->P.levels[0].l0;
     s->dt = 1e-3;
+}
+
+static void scene_open(scene *s, const char *dict, int collision)
+{
+    lub_mps_config c;
+    scene_particles(s, dict, &c);
+    c.alpha = 1e-6 / (s->P.levels[0].l0 * s->P.levels[0].l0); /* closed channels */
+    c.collision = collision;
+    scene_solver(s, &c);
 }
 
 static void scene_close(scene *s)
@@ -417,21 +429,13 @@ static const char *pool2 = "dimension: 2\n"
 static void pool_step(int squeezed, scene *s, size_t moved[4], lub_step_status *st, char *msg,
                       size_t msgsize)
 {
-    memset(s, 0, sizeof *s);
-    generate(pool2, &s->P, &s->g);
     lub_mps_config c;
-    lub_mps_config_defaults(&c);
-    c.rho = 1000;
-    c.nu = 1e-6;
-    c.viscosity = LUB_VISCOSITY_CN;
+    scene_particles(s, pool2, &c);
     c.alpha = 0;
     c.re_l0 = 2.1;
     c.gravity = 1, c.g[1] = -9.81; /* a pressure in the pool */
     c.clip_negative = LUB_NEGATIVE_KEEP;
-    c.reorder_interval = 0; /* particle indices stay put */
-    lub_mps_init(&s->m, &s->P, &c, s->g.dmin, s->g.dmax, s->g.periodic);
-    s->l0 = s->P.levels[0].l0;
-    s->dt = 1e-3;
+    scene_solver(s, &c);
     /* the four fluid particles nearest the pool's upper right corner, moved to (0.022, 0.02) */
     const double corner[3] = {0.0175, 0.0075, 0};
     for (int k = 0; k < 4; k++) {
