@@ -935,8 +935,10 @@ void lub_particles_read_info(const char *path, lub_particles_info *info)
 /* ------------------------------------------------------------------------------------------ */
 /* XDMF                                                                                       */
 
+/* Indentation is a number of spaces (printed as "%*s" of ""). */
+
 /* One DataItem referring to <prefix>particles.h5:/fields/<name>. */
-static void xdmf_item(FILE *fp, const char *indent, const char *prefix, const char *name, size_t n,
+static void xdmf_item(FILE *fp, int indent, const char *prefix, const char *name, size_t n,
                       int ncols, const char *numtype, int precision)
 {
     char dims[64];
@@ -945,20 +947,18 @@ static void xdmf_item(FILE *fp, const char *indent, const char *prefix, const ch
     else
         snprintf(dims, sizeof dims, "%zu", n);
     fprintf(fp,
-            "%s<DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"%d\" "
+            "%*s<DataItem Dimensions=\"%s\" NumberType=\"%s\" Precision=\"%d\" "
             "Format=\"HDF\">%sparticles.h5:/fields/%s</DataItem>\n",
-            indent, dims, numtype, precision, prefix, name);
+            indent, "", dims, numtype, precision, prefix, name);
 }
 
-static void xdmf_attribute(FILE *fp, const char *indent, const char *prefix, const char *name,
-                           size_t n, int ncols, const char *numtype, int precision)
+static void xdmf_attribute(FILE *fp, int indent, const char *prefix, const char *name, size_t n,
+                           int ncols, const char *numtype, int precision)
 {
-    char inner[32];
-    snprintf(inner, sizeof inner, "%s  ", indent);
-    fprintf(fp, "%s<Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n", indent, name,
-            ncols > 1 ? "Vector" : "Scalar");
-    xdmf_item(fp, inner, prefix, name, n, ncols, numtype, precision);
-    fprintf(fp, "%s</Attribute>\n", indent);
+    fprintf(fp, "%*s<Attribute Name=\"%s\" AttributeType=\"%s\" Center=\"Node\">\n", indent, "",
+            name, ncols > 1 ? "Vector" : "Scalar");
+    xdmf_item(fp, indent + 2, prefix, name, n, ncols, numtype, precision);
+    fprintf(fp, "%*s</Attribute>\n", indent, "");
 }
 
 /* One uniform grid of n points: a Polyvertex topology whose connectivity (written by
@@ -967,29 +967,26 @@ static void xdmf_attribute(FILE *fp, const char *indent, const char *prefix, con
  * The id (uint64 in the file) is described as Int 8 because ParaView's Xdmf3 reader has no
  * 64-bit unsigned array type and skips such arrays; HDF5 converts on reading, exact for ids
  * below 2^63. */
-static void xdmf_grid(FILE *fp, const char *indent, const char *name, double time,
-                      const char *prefix, size_t n, int conn_bytes, int nextra,
-                      const char extra[][LUB_NAME_MAX])
+static void xdmf_grid(FILE *fp, int indent, const char *name, double time, const char *prefix,
+                      size_t n, int conn_bytes, int nextra, const char extra[][LUB_NAME_MAX])
 {
-    char in1[32], in2[32];
-    snprintf(in1, sizeof in1, "%s  ", indent);
-    snprintf(in2, sizeof in2, "%s    ", indent);
-    fprintf(fp, "%s<Grid Name=\"%s\" GridType=\"Uniform\">\n", indent, name);
-    fprintf(fp, "%s<Time Value=\"%.17g\"/>\n", in1, time);
+    const int in1 = indent + 2, in2 = indent + 4;
+    fprintf(fp, "%*s<Grid Name=\"%s\" GridType=\"Uniform\">\n", indent, "", name);
+    fprintf(fp, "%*s<Time Value=\"%.17g\"/>\n", in1, "", time);
     fprintf(fp,
-            "%s<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
+            "%*s<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
             "NodesPerElement=\"1\"%s>\n",
-            in1, n, conn_bytes ? "" : "/");
+            in1, "", n, conn_bytes ? "" : "/");
     if (conn_bytes) {
         fprintf(fp,
-                "%s<DataItem Dimensions=\"%zu\" NumberType=\"%s\" Precision=\"%d\" "
+                "%*s<DataItem Dimensions=\"%zu\" NumberType=\"%s\" Precision=\"%d\" "
                 "Format=\"HDF\">%sparticles.h5:/xdmf/connectivity</DataItem>\n",
-                in2, n, conn_bytes == 4 ? "UInt" : "Int", conn_bytes, prefix);
-        fprintf(fp, "%s</Topology>\n", in1);
+                in2, "", n, conn_bytes == 4 ? "UInt" : "Int", conn_bytes, prefix);
+        fprintf(fp, "%*s</Topology>\n", in1, "");
     }
-    fprintf(fp, "%s<Geometry GeometryType=\"XYZ\">\n", in1);
+    fprintf(fp, "%*s<Geometry GeometryType=\"XYZ\">\n", in1, "");
     xdmf_item(fp, in2, prefix, "position", n, 3, "Float", 8);
-    fprintf(fp, "%s</Geometry>\n", in1);
+    fprintf(fp, "%*s</Geometry>\n", in1, "");
     xdmf_attribute(fp, in1, prefix, "velocity", n, 3, "Float", 8);
     xdmf_attribute(fp, in1, prefix, "pressure", n, 1, "Float", 8);
     xdmf_attribute(fp, in1, prefix, "kind", n, 1, "UChar", 1);
@@ -997,7 +994,7 @@ static void xdmf_grid(FILE *fp, const char *indent, const char *name, double tim
     xdmf_attribute(fp, in1, prefix, "level", n, 1, "UChar", 1);
     xdmf_attribute(fp, in1, prefix, "id", n, 1, "Int", 8);
     for (int e = 0; e < nextra; e++) xdmf_attribute(fp, in1, prefix, extra[e], n, 1, "Float", 8);
-    fprintf(fp, "%s</Grid>\n", indent);
+    fprintf(fp, "%*s</Grid>\n", indent, "");
 }
 
 static void xdmf_head(FILE *fp)
@@ -1023,7 +1020,7 @@ static void write_sidecar(const lub_particles *P, const char *dir)
     FILE *fp = lub_atomic_open(&af, path);
     if (!fp) lub_fatal_run("%s: cannot write: %s", path, strerror(errno));
     xdmf_head(fp);
-    xdmf_grid(fp, "    ", "particles", P->time, "", P->n, P->n <= UINT32_MAX ? 4 : 8, P->nextra,
+    xdmf_grid(fp, 4, "particles", P->time, "", P->n, P->n <= UINT32_MAX ? 4 : 8, P->nextra,
               (const char(*)[LUB_NAME_MAX])extra);
     xdmf_tail(fp);
     if (lub_atomic_close(&af) != 0) lub_fatal_run("%s: cannot write: %s", path, strerror(errno));
@@ -1058,7 +1055,7 @@ size_t lub_case_xdmf_write(const lub_case *c)
                         "CollectionType=\"Temporal\">\n");
         }
         snprintf(prefix, sizeof prefix, "%s/", times[k].name);
-        xdmf_grid(fp, "      ", times[k].name, times[k].value, prefix, info.n, info.conn_bytes,
+        xdmf_grid(fp, 6, times[k].name, times[k].value, prefix, info.n, info.conn_bytes,
                   info.nextra, (const char(*)[LUB_NAME_MAX])info.extra);
         listed++;
     }
