@@ -451,17 +451,19 @@ static void test_order_3d(void)
 /* The binning runs in chunks of particles on several threads once there are enough of
  * them: its result is the serial counting sort's, a permutation stable by cell (checked
  * here from the cells directly), the same with 1, 2 and 3 threads, escaped particles
- * included. */
-static void test_bin_threads(void)
+ * included.  The particles fill y < 0.5 of a box of height `height`: 0.5 (a quarter of a
+ * cell per particle) or 5 (2.5 cells per particle, most of them empty, as in a wedge's box;
+ * the scan over the cells then runs on the threads too). */
+static void bin_threads(double height)
 {
-    const double lo[3] = {0, 0, 0}, hi[3] = {1.0, 0.5, 0};
+    const double lo[3] = {0, 0, 0}, hi[3] = {1.0, height, 0};
     const int per[3] = {1, 0, 0};
     const size_t n = 20000;
     cloud c;
     cloud_init(&c, n);
     size_t nesc = 0;
     for (size_t k = 0; k < n; k++) {
-        double y = hi[1] * rnd();
+        double y = 0.5 * rnd();
         if (k % 997 == 1) y = hi[1] + 0.05, nesc++;  /* escaped */
         cloud_add(&c, 2.0 * rnd() - 0.5, y, 0.0, 0); /* x: periodic images too */
     }
@@ -495,6 +497,12 @@ static void test_bin_threads(void)
     lub_neighbours_free(&a);
     lub_neighbours_free(&b);
     cloud_free(&c);
+}
+
+static void test_bin_threads(void)
+{
+    bin_threads(0.5);
+    bin_threads(5.0);
 }
 
 /* Cells of rs / 2 (reach 2) unless their grid would exceed LUB_NEIGHBOURS_FINE_CELLS_MAX
