@@ -18,7 +18,9 @@
 # binaries for any x86-64).  The wider vectors change no result: floating-point contraction
 # (fused multiply-add) is off, and the solver's sums keep their order (the thesis wedge's
 # particles after 96 steps are bit-identical between -O2 and -O3 -march=native), while a step
-# costs 5-15% less (tutorials/README.md).  A change of CC, OPT or ARCH rebuilds everything.
+# costs 2-7% less on two threads, 2-15% on one (tutorials/README.md).  -fno-math-errno: no
+# caller reads errno after sqrt, and without it a loop with sqrt does not vectorise (the
+# neighbour lists' weights).  A change of CC, OPT or ARCH rebuilds everything.
 
 CC       ?= cc
 PREFIX   ?= /usr/local
@@ -45,7 +47,7 @@ GITREV   := $(shell git rev-parse --short HEAD 2>/dev/null || echo unknown)
 
 CPPFLAGS += -Isrc $(if $(CHOLMOD_INC),-I$(CHOLMOD_INC)) $(PKG_CFLAGS) \
             -D_POSIX_C_SOURCE=200809L -DLUB_VERSION='"$(VERSION)"' -DLUB_GITREV='"$(GITREV)"'
-CFLAGS   += -std=c11 $(OPT) $(ARCH) -ffp-contract=off -g -Wall -Wextra -fopenmp -MMD -MP
+CFLAGS   += -std=c11 $(OPT) $(ARCH) -ffp-contract=off -fno-math-errno -g -Wall -Wextra -fopenmp -MMD -MP
 LDLIBS   += $(PKG_LIBS) $(CHOLMOD_LIBS) -lm
 LDFLAGS  += -fopenmp $(LDSAN)
 
@@ -70,7 +72,7 @@ all: $(LIB) $(BINS)
 # The code-generation flags of the objects in $(BUILD): rewritten (and so newer than every
 # object) only when they change.
 FLAGS_STAMP := $(BUILD)/flags
-FLAGS_NOW   := $(CC) $(OPT) $(ARCH)
+FLAGS_NOW   := $(CC) $(OPT) $(ARCH) -fno-math-errno
 $(shell mkdir -p $(BUILD) && { [ "$$(cat $(FLAGS_STAMP) 2>/dev/null)" = '$(FLAGS_NOW)' ] \
           || echo '$(FLAGS_NOW)' > $(FLAGS_STAMP); })
 

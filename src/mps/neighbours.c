@@ -458,16 +458,16 @@ static void count_sweep(lub_neighbours *nb)
     }
 }
 
-/* Store the pairs, one segment at a time: first the sorted index k of every candidate is
- * written at the next free place, which advances only for a pair (no unpredictable branch;
- * the write is skipped once the particle's range is full, so a thread never writes into
- * another particle's range); then the segment's new pairs get their displacement, distance,
- * (T-6) weight and particle index. */
+/* Store the pairs: the sorted index k, displacement and squared distance of every candidate
+ * are written at the next free place, which advances only for a pair (no unpredictable
+ * branch; the write is skipped once the particle's range is full, so a thread never writes
+ * into another particle's range); then the particle's pairs get their (T-6) weight and
+ * particle index. */
 static void fill_sweep(lub_neighbours *nb)
 {
     const size_t n = nb->n;
     const int dim = nb->dim;
-    const double rs2 = nb->rs * nb->rs, re = nb->re;
+    const double rs2 = nb->rs * nb->rs, re = nb->re, inv_re = 1.0 / re;
     const double *const xs[3] = {nb->xs[0], nb->xs[1], nb->xs[2]};
     uint32_t *restrict J = nb->j;
     const uint32_t *restrict perm = nb->perm;
@@ -487,26 +487,28 @@ static void fill_sweep(lub_neighbours *nb)
             const size_t c = nb->cell[i], ki = nb->spos[i];
             if (c != last_cell) ns = cell_segments(nb, c, seg), last_cell = c;
             const double xi[3] = {xs[0][ki], xs[1][ki], dim == 3 ? xs[2][ki] : 0.0};
+            const size_t m0 = m;
             for (int s = 0; s < ns; s++) {
                 const double p[3] = {seg[s].s[0] - xi[0], seg[s].s[1] - xi[1], seg[s].s[2] - xi[2]};
-                const size_t ms = m;
                 for (size_t k = seg[s].k0; k < seg[s].k1; k++) {
                     double d[3];
                     const double r2 = dist2(dim, xs, k, p, d);
-                    if (m < end) J[m] = (uint32_t)k;
+                    if (m < end) {
+                        J[m] = (uint32_t)k, DX[m] = d[0], DY[m] = d[1], W[m] = r2;
+                        if (dim == 3) DZ[m] = d[2];
+                    }
                     m += (r2 < rs2) & (k != ki);
                 }
-                const size_t me = m < end ? m : end;
-                for (size_t q = ms; q < me; q++) {
-                    const size_t k = J[q];
-                    double d[3];
-                    const double r = sqrt(dist2(dim, xs, k, p, d));
-                    DX[q] = d[0], DY[q] = d[1];
-                    if (dim == 3) DZ[q] = d[2];
-                    W[q] = lub_mps_weight(r, re);
-                    J[q] = perm[k];
-                }
             }
+            /* the particle's pairs at once: r^2 becomes the (T-6) weight, lub_mps_weight's
+             * value written without a branch so that the loop vectorises (r < rs is finite),
+             * and the sorted index the particle index */
+            const size_t me = m < end ? m : end;
+            for (size_t q = m0; q < me; q++) {
+                const double r = sqrt(W[q]), t = r * inv_re - 1.0;
+                W[q] = (double)(r < re) * (t * t);
+            }
+            for (size_t q = m0; q < me; q++) J[q] = perm[J[q]];
             if (m != end) mismatch = 1;
         }
     }
