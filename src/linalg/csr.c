@@ -61,6 +61,24 @@ void lub_csr_alloc(lub_csr *A)
     A->nnz = (int)nnz;
 }
 
+/* Sort row i's columns (insertion sort: O(len) when the row is already nearly sorted). */
+static void sort_row(int *c, double *v, int len)
+{
+    for (int k = 1; k < len; k++) {
+        int ck = c[k];
+        if (c[k - 1] <= ck) continue;
+        double vk = v[k];
+        int m = k - 1;
+        while (m >= 0 && c[m] > ck) {
+            c[m + 1] = c[m];
+            v[m + 1] = v[m];
+            m--;
+        }
+        c[m + 1] = ck;
+        v[m + 1] = vk;
+    }
+}
+
 void lub_csr_finish(lub_csr *A)
 {
     const int n = A->n;
@@ -70,30 +88,25 @@ void lub_csr_finish(lub_csr *A)
         int *c = A->col + A->row_ptr[i];
         double *v = A->val + A->row_ptr[i];
         const int len = A->row_ptr[i + 1] - A->row_ptr[i];
-        /* insertion sort: O(len) when the row is already (nearly) sorted */
-        for (int k = 1; k < len; k++) {
-            int ck = c[k];
-            if (c[k - 1] <= ck) continue;
-            double vk = v[k];
-            int m = k - 1;
-            while (m >= 0 && c[m] > ck) {
-                c[m + 1] = c[m];
-                v[m + 1] = v[m];
-                m--;
-            }
-            c[m + 1] = ck;
-            v[m + 1] = vk;
+        /* one pass over a row that is already strictly increasing (the usual case: rows
+         * assembled from sorted neighbour lists), finding the diagonal on the way; a row that
+         * is not is sorted first */
+        int d = -1, k = 1;
+        for (; k < len && c[k - 1] < c[k]; k++) d = c[k - 1] == i ? k - 1 : d;
+        if (k < len) {
+            sort_row(c, v, len);
+            d = -1;
+            for (k = 1; k < len && c[k - 1] < c[k]; k++) d = c[k - 1] == i ? k - 1 : d;
         }
-        int d = -1, kind = 0;
-        for (int k = 0; k < len; k++) {
-            if (c[k] < 0 || c[k] >= n)
-                kind = 1;
-            else if (k > 0 && c[k] == c[k - 1])
-                kind = 2;
-            if (c[k] == i) d = A->row_ptr[i] + k;
-        }
-        if (d < 0 && !kind) kind = 3;
-        A->diag[i] = d;
+        if (len > 0 && c[len - 1] == i) d = len - 1;
+        int kind = 0;
+        if (len > 0 && (c[0] < 0 || c[len - 1] >= n))
+            kind = 1;
+        else if (k < len)
+            kind = 2; /* sorted, but not strictly: a repeated column */
+        else if (d < 0)
+            kind = 3;
+        A->diag[i] = d < 0 ? -1 : A->row_ptr[i] + d;
         if (kind) {
 #pragma omp critical(lub_csr_finish_bad)
             if (bad_row < 0 || i < bad_row) {

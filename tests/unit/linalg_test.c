@@ -11,6 +11,9 @@
 #include <omp.h>
 #include <stdlib.h>
 #include <string.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include "linalg/csr.h"
 #include "linalg/linsolve.h"
@@ -62,6 +65,76 @@ static void csr_from_dense(lub_csr *A, int n, const double *D)
         }
     }
     lub_csr_finish(A);
+}
+
+/* lub_csr_finish on a 4-row matrix whose row 2 has the columns c[0..len) (the other rows
+ * only their diagonal), in a child process: lub_csr_finish stops a bad matrix with lub_bug
+ * (abort).  Returns 1 if the child aborted, its message in msg; 0 if it returned. */
+static int finish_row2(const int *c, int len, char *msg, size_t size)
+{
+    int fd[2];
+    msg[0] = '\0';
+    if (pipe(fd) != 0) return -1;
+    fflush(stdout);
+    pid_t pid = fork();
+    if (pid == 0) {
+        dup2(fd[1], 2);
+        close(fd[0]);
+        lub_csr A;
+        lub_csr_init(&A);
+        lub_csr_begin(&A, 4);
+        for (int i = 0; i < 4; i++) lub_csr_set_row_length(&A, i, i == 2 ? len : 1);
+        lub_csr_alloc(&A);
+        for (int i = 0; i < 4; i++)
+            for (int k = 0; k < lub_csr_row_length(&A, i); k++) {
+                lub_csr_row_col(&A, i)[k] = i == 2 ? c[k] : i;
+                lub_csr_row_val(&A, i)[k] = 1.0;
+            }
+        lub_csr_finish(&A);
+        _exit(0);
+    }
+    close(fd[1]);
+    size_t got = 0;
+    ssize_t r;
+    while (got + 1 < size && (r = read(fd[0], msg + got, size - 1 - got)) > 0) got += (size_t)r;
+    msg[got] = '\0';
+    close(fd[0]);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    return WIFSIGNALED(status) && WTERMSIG(status) == SIGABRT;
+}
+
+/* The rows lub_csr_finish refuses (an internal error: assembly bugs), sorted or not, and
+ * rows it takes: the diagonal first, last, alone, or in a row that needed sorting. */
+static void test_csr_finish_checks(void)
+{
+    char msg[1024];
+    static const struct {
+        int c[5], len;
+        const char *what; /* NULL: accepted */
+    } rows[] = {
+        {{1, 2, 4}, 3, "a column out of range"},
+        {{-1, 2, 3}, 3, "a column out of range"},
+        {{4, 2, 1}, 3, "a column out of range"},
+        {{1, 2, 2, 3}, 4, "a repeated column"},
+        {{3, 2, 1, 2}, 4, "a repeated column"},
+        {{0, 1, 3}, 3, "no diagonal entry"},
+        {{3, 1}, 2, "no diagonal entry"},
+        {{2}, 1, NULL},
+        {{2, 3}, 2, NULL},
+        {{0, 1, 2}, 3, NULL},
+        {{3, 0, 2, 1}, 4, NULL},
+    };
+    for (size_t t = 0; t < sizeof rows / sizeof rows[0]; t++) {
+        const int aborted = finish_row2(rows[t].c, rows[t].len, msg, sizeof msg);
+        if (rows[t].what) {
+            CHECK(aborted == 1);
+            CHECK_STR(msg, "row 2 of 4");
+            CHECK_STR(msg, rows[t].what);
+        } else {
+            CHECK(aborted == 0);
+        }
+    }
 }
 
 /* lub_csr_finish sorts each row with its values: rows of interleaved ascending runs (as
@@ -1260,6 +1333,7 @@ int main(void)
 {
     RUN(test_csr_random_pattern_matches_dense);
     RUN(test_csr_sort_rows);
+    RUN(test_csr_finish_checks);
     RUN(test_pcg_poisson1d_each_preconditioner);
     RUN(test_pcg_poisson2d_each_preconditioner);
     RUN(test_ic0_exact_on_tridiagonal);
