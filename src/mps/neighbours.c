@@ -458,6 +458,27 @@ static void count_sweep(lub_neighbours *nb)
     }
 }
 
+/* The candidates of one segment for particle ki (sorted index), stored from place m on (see
+ * fill_sweep); returns the next free place.  dim is a literal at the call sites, so that
+ * the loop keeps its pointers in registers. */
+static inline size_t store_candidates(const double *const xs[3], const segment *sg,
+                                      const double p[3], size_t ki, size_t m, size_t end,
+                                      double rs2, uint32_t *restrict J, double *restrict DX,
+                                      double *restrict DY, double *restrict DZ, double *restrict W,
+                                      const int dim)
+{
+    for (size_t k = sg->k0; k < sg->k1; k++) {
+        double d[3];
+        const double r2 = dist2(dim, xs, k, p, d);
+        if (m < end) {
+            J[m] = (uint32_t)k, DX[m] = d[0], DY[m] = d[1], W[m] = r2;
+            if (dim == 3) DZ[m] = d[2];
+        }
+        m += (r2 < rs2) & (k != ki);
+    }
+    return m;
+}
+
 /* Store the pairs: the sorted index k, displacement and squared distance of every candidate
  * are written at the next free place, which advances only for a pair (no unpredictable
  * branch; the write is skipped once the particle's range is full, so a thread never writes
@@ -490,15 +511,10 @@ static void fill_sweep(lub_neighbours *nb)
             const size_t m0 = m;
             for (int s = 0; s < ns; s++) {
                 const double p[3] = {seg[s].s[0] - xi[0], seg[s].s[1] - xi[1], seg[s].s[2] - xi[2]};
-                for (size_t k = seg[s].k0; k < seg[s].k1; k++) {
-                    double d[3];
-                    const double r2 = dist2(dim, xs, k, p, d);
-                    if (m < end) {
-                        J[m] = (uint32_t)k, DX[m] = d[0], DY[m] = d[1], W[m] = r2;
-                        if (dim == 3) DZ[m] = d[2];
-                    }
-                    m += (r2 < rs2) & (k != ki);
-                }
+                if (dim == 2)
+                    m = store_candidates(xs, &seg[s], p, ki, m, end, rs2, J, DX, DY, DZ, W, 2);
+                else
+                    m = store_candidates(xs, &seg[s], p, ki, m, end, rs2, J, DX, DY, DZ, W, 3);
             }
             /* the particle's pairs at once: r^2 becomes the (T-6) weight, lub_mps_weight's
              * value written without a branch so that the loop vectorises (r < rs is finite),
