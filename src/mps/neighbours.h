@@ -60,16 +60,6 @@
 #define LUB_NEIGHBOURS_MAX_REACH      2
 #define LUB_NEIGHBOURS_FINE_CELLS_MAX 16777216.0
 
-/* Loops over particles whose work varies from particle to particle (lists for some kinds
- * only, operators on the fluid only, neighbourhoods of different sizes) hand out chunks of
- * this many particles to the threads as they come free (OpenMP schedule(dynamic)): with a
- * static split, the thread whose half held more work kept the other waiting (perf on the
- * thesis wedge: the main thread waited at the loops' ends for 18% of its time, 8% with
- * this schedule).  Only loops where a particle's result does not depend on which
- * thread computes it (no floating-point sum across particles) are scheduled so, so the
- * results do not depend on the schedule. */
-#define LUB_PARTICLE_CHUNK 512
-
 typedef struct {
     int dim;   /* 2 or 3 */
     double re; /* effective radius of the weight */

@@ -54,7 +54,7 @@ void lub_mps_pnd(const lub_neighbours *nb, const lub_mps_mask *mask, double *pnd
 {
     const mask_view mv = view(mask);
     const size_t n = nb->n;
-#pragma omp parallel for schedule(dynamic, LUB_PARTICLE_CHUNK)
+#pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         if (!takes_part(mv.ikind, mv.i, i)) continue;
         double s = 0.0;
@@ -71,7 +71,7 @@ void lub_mps_laplacian(const lub_neighbours *nb, const lub_mps_mask *mask, doubl
     const mask_view mv = view(mask);
     const size_t n = nb->n;
     const double c = 2.0 * nb->dim / (lambda0 * n0); /* (T-3) */
-#pragma omp parallel for schedule(dynamic, LUB_PARTICLE_CHUNK)
+#pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         if (!takes_part(mv.ikind, mv.i, i)) continue;
         const double phii = phi[i];
@@ -129,7 +129,7 @@ void lub_mps_gradient(const lub_neighbours *nb, const lub_mps_mask *mask, double
     const size_t n = nb->n;
     const int dim = nb->dim;
     const double c = dim / n0; /* (T-13) */
-#pragma omp parallel for schedule(dynamic, LUB_PARTICLE_CHUNK)
+#pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         if (!takes_part(mv.ikind, mv.i, i)) continue;
         const double ph = shift ? min_pressure(nb, &mv, p, i) : p[i]; /* (T-14) */
@@ -151,7 +151,7 @@ size_t lub_mps_gradient_lsmps(const lub_neighbours *nb, const lub_mps_mask *mask
     const int dim = nb->dim;
     if (!(det_min > 0)) det_min = LUB_MPS_LSMPS_DET_MIN;
     size_t fallbacks = 0;
-#pragma omp parallel for schedule(dynamic, LUB_PARTICLE_CHUNK) reduction(+ : fallbacks)
+#pragma omp parallel for schedule(static) reduction(+ : fallbacks)
     for (size_t i = 0; i < n; i++) {
         if (!takes_part(mv.ikind, mv.i, i)) continue;
         const double ph = shift ? min_pressure(nb, &mv, p, i) : p[i]; /* (T-14) */

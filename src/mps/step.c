@@ -212,7 +212,7 @@ static void smooth_fluid(lub_mps *m, double *const f[3], double *const out[3])
     const lub_particles *P = m->P;
     const lub_neighbours *nb = &m->nb;
     const int dim = m->dim;
-#pragma omp parallel for schedule(dynamic, LUB_PARTICLE_CHUNK)
+#pragma omp parallel for schedule(static)
     for (size_t i = 0; i < P->n; i++) {
         if (P->kind[i] != LUB_FLUID) continue;
         double sw = 0, s[3] = {0, 0, 0};
@@ -356,7 +356,7 @@ static void free_surface(lub_mps *m)
     const size_t n = P->n;
     const double lim = m->c.beta * m->n0, asym = m->c.asymmetry * m->l0;
     size_t ns = 0;
-#pragma omp parallel for schedule(dynamic, LUB_PARTICLE_CHUNK) reduction(+ : ns)
+#pragma omp parallel for schedule(static) reduction(+ : ns)
     for (size_t i = 0; i < n; i++) {
         uint8_t s = 0;
         if (P->kind[i] != LUB_DUMMY) {
@@ -596,7 +596,7 @@ static void collision(lub_mps *m, double dt)
     const double dc = m->c.collision_distance * m->l0, e = m->c.restitution;
     double *du[3] = {m->grad[0], m->grad[1], m->grad[2]};
     double *x[3] = {P->x[0], P->x[1], P->x[2]};
-#pragma omp parallel for schedule(dynamic, LUB_PARTICLE_CHUNK)
+#pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         double acc[3] = {0, 0, 0};
         /* a fixed-band particle keeps its given velocity (it still stops the others) */
@@ -835,7 +835,7 @@ static long through_wall(const lub_mps *m, double dt, unsigned *patch, double *t
     long first = none;
     /* from the fluid side (the dummies have no lists of their own): each fluid particle near
      * a dummy of a patch, tested against that patch */
-#pragma omp parallel for schedule(dynamic, LUB_PARTICLE_CHUNK) reduction(min : first)
+#pragma omp parallel for schedule(static) reduction(min : first)
     for (size_t i = 0; i < P->n; i++) {
         if (P->kind[i] != LUB_FLUID || (long)i >= first) continue;
         if (m->fixed && m->fixed[i]) continue; /* given: lub_mps_buried */
@@ -870,7 +870,7 @@ size_t lub_mps_buried(const lub_mps *m, double dt, uint8_t *flag)
     if (!m->fixed) return 0;
     size_t n = 0;
     /* from the fluid side (the dummies have no lists of their own) */
-#pragma omp parallel for schedule(dynamic, LUB_PARTICLE_CHUNK) reduction(+ : n)
+#pragma omp parallel for schedule(static) reduction(+ : n)
     for (size_t i = 0; i < P->n; i++) {
         if (P->kind[i] != LUB_FLUID || !m->fixed[i]) continue;
         for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
