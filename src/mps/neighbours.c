@@ -425,8 +425,8 @@ static inline double dist2(int dim, const double *const xs[3], size_t k, const d
  * schedule), although the halves' work differs (lists for some kinds only): handing out
  * chunks as threads come free (tried: dynamic, 512) cut the threads' waiting, but each thread
  * then wrote and read particles all over the arrays, and the pressure solve that follows ran
- * 4-10% slower on the thesis wedge, a net loss.  The same half of the particles on the same
- * thread in every phase keeps the data in that core's caches. */
+ * 3-24% slower on the thesis wedge (mostly about 10%), a net loss.  The same half of the
+ * particles on the same thread in every phase keeps the data in that core's caches. */
 static void count_sweep(lub_neighbours *nb)
 {
     const size_t n = nb->n;
@@ -523,14 +523,10 @@ static void fill_sweep(lub_neighbours *nb)
                 else
                     m = store_candidates(xs, &seg[s], p, ki, m, end, rs2, J, DX, DY, DZ, W, 3);
             }
-            /* the particle's pairs at once: r^2 becomes the (T-6) weight, lub_mps_weight's
-             * value written without a branch so that the loop vectorises (r < rs is finite),
-             * and the sorted index the particle index */
+            /* the particle's pairs at once: r^2 becomes the (T-6) weight (in a loop that
+             * vectorises), the sorted index the particle index */
             const size_t me = m < end ? m : end;
-            for (size_t q = m0; q < me; q++) {
-                const double r = sqrt(W[q]), t = r * inv_re - 1.0;
-                W[q] = (double)(r < re) * (t * t);
-            }
+            for (size_t q = m0; q < me; q++) W[q] = lub_mps_weight_pair(sqrt(W[q]), inv_re, re);
             for (size_t q = m0; q < me; q++) J[q] = perm[J[q]];
             if (m != end) mismatch = 1;
         }

@@ -16,4 +16,12 @@ static inline double lub_mps_weight(double r, double re)
     return r < re ? q * q : 0.0;
 }
 
+/* The same value for a finite r >= 0 (a listed pair's distance), written without a branch
+ * so that a loop over pairs vectorises (the neighbour search's); inv_re = 1.0 / re. */
+static inline double lub_mps_weight_pair(double r, double inv_re, double re)
+{
+    const double q = r * inv_re - 1.0;
+    return (double)(r < re) * (q * q);
+}
+
 #endif

@@ -222,6 +222,14 @@ static void test_weight(void)
     CHECK(lub_mps_weight(2.0, 2.0) == 0.0);
     CHECK(lub_mps_weight(3.0, 2.0) == 0.0);
     CHECK_NEAR(lub_mps_weight(1.5, 2.0), 0.0625, 1e-16);
+    /* the branch-free form for listed pairs: the same bits from 0 to past re */
+    int same = 1;
+    for (int k = 0; k <= 4000; k++) {
+        const double re = 3.1e-6, r = 1.5 * re * k / 4000.0 + (k % 7) * 1e-22;
+        same &= lub_mps_weight_pair(r, 1.0 / re, re) == lub_mps_weight(r, re);
+    }
+    same &= lub_mps_weight_pair(3.1e-6, 1.0 / 3.1e-6, 3.1e-6) == 0.0;
+    CHECK(same);
 }
 
 static void test_search_2d(void)
