@@ -513,9 +513,6 @@ static void test_bin_threads(void)
     bin_threads(5.0);
 }
 
-/* Cells of rs / 2 (reach 2) unless their grid would exceed LUB_NEIGHBOURS_FINE_CELLS_MAX
- * cells: then cells of rs (reach 1), 8 times fewer in 3-D; the lists are complete either way
- * (a big, sparsely filled 3-D box: 260^3 half cells, 130^3 full ones). */
 /* Lists of some kinds only (list_kind, list_kinds): a particle of another kind gets an empty
  * list and stays in the others'; the lists built are those of a full build, entry for entry
  * (the full build is itself checked against brute force above). */
@@ -567,6 +564,9 @@ static void test_list_kinds(void)
     check_list_kinds(3, none);
 }
 
+/* Cells of rs / 2 (reach 2) unless their grid would exceed LUB_NEIGHBOURS_FINE_CELLS_MAX
+ * cells: then cells of rs (reach 1), 8 times fewer in 3-D; the lists are complete either way
+ * (a big, sparsely filled 3-D box: 260^3 half cells, 130^3 full ones). */
 static void test_cell_reach(void)
 {
     const double lo[3] = {0, 0, 0}, small[3] = {0.1, 0.1, 0.1}, big[3] = {1.3, 1.3, 1.3};
