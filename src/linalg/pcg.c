@@ -402,6 +402,59 @@ static double residual(const lub_csr *A, const double *b, const double *x, doubl
     return s;
 }
 
+/* r_k = b_k - A x_k and rr[k] = r_k.r_k for m = 2 or 3 right-hand sides in one pass over A
+ * (the warm starts of lub_pcg_solve_multi); per right-hand side the arithmetic of residual. */
+static void residual_multi(const lub_csr *A, int m, const double *const *b, double *const *x,
+                           double *const *r, double *rr)
+{
+    const int n = A->n;
+    const int *rp = A->row_ptr, *col = A->col;
+    const double *val = A->val;
+    if (m == 2) {
+        const double *b0 = b[0], *b1 = b[1], *x0 = x[0], *x1 = x[1];
+        double *r0 = r[0], *r1 = r[1], s0 = 0.0, s1 = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : s0, s1) if (n > LUB_LINALG_OMP_MIN)
+        for (int i = 0; i < n; i++) {
+            double t0 = b0[i], t1 = b1[i];
+            for (int k = rp[i]; k < rp[i + 1]; k++) {
+                const double a = val[k];
+                const int j = col[k];
+                t0 -= a * x0[j];
+                t1 -= a * x1[j];
+            }
+            r0[i] = t0;
+            r1[i] = t1;
+            s0 += t0 * t0;
+            s1 += t1 * t1;
+        }
+        rr[0] = s0;
+        rr[1] = s1;
+    } else {
+        const double *b0 = b[0], *b1 = b[1], *b2 = b[2], *x0 = x[0], *x1 = x[1], *x2 = x[2];
+        double *r0 = r[0], *r1 = r[1], *r2 = r[2], s0 = 0.0, s1 = 0.0, s2 = 0.0;
+#pragma omp parallel for schedule(static) reduction(+ : s0, s1, s2) if (n > LUB_LINALG_OMP_MIN)
+        for (int i = 0; i < n; i++) {
+            double t0 = b0[i], t1 = b1[i], t2 = b2[i];
+            for (int k = rp[i]; k < rp[i + 1]; k++) {
+                const double a = val[k];
+                const int j = col[k];
+                t0 -= a * x0[j];
+                t1 -= a * x1[j];
+                t2 -= a * x2[j];
+            }
+            r0[i] = t0;
+            r1[i] = t1;
+            r2[i] = t2;
+            s0 += t0 * t0;
+            s1 += t1 * t1;
+            s2 += t2 * t2;
+        }
+        rr[0] = s0;
+        rr[1] = s1;
+        rr[2] = s2;
+    }
+}
+
 /* x += alpha p, r -= alpha q, returns r.r */
 static double update_xr(int n, double alpha, const double *p, const double *q, double *x, double *r)
 {
@@ -479,8 +532,9 @@ void lub_pcg_solve_multi(lub_pcg_work *w, const lub_csr *A, int nrhs, const doub
     double *r[LUB_PCG_MAX_RHS], *z[LUB_PCG_MAX_RHS], *p[LUB_PCG_MAX_RHS], *q[LUB_PCG_MAX_RHS];
     double bnorm[LUB_PCG_MAX_RHS], rz[LUB_PCG_MAX_RHS], rr[LUB_PCG_MAX_RHS];
     lub_solve_status st[LUB_PCG_MAX_RHS];
-    int act[LUB_PCG_MAX_RHS], na = 0;  /* the right-hand sides still iterating */
-    int inloop[LUB_PCG_MAX_RHS] = {0}; /* went into the iterations (not done at the start) */
+    int act[LUB_PCG_MAX_RHS], na = 0;   /* the right-hand sides still iterating */
+    int inloop[LUB_PCG_MAX_RHS] = {0};  /* went into the iterations (not done at the start) */
+    int start[LUB_PCG_MAX_RHS], ns = 0; /* the right-hand sides that need a start */
     for (int k = 0; k < nrhs; k++) {
         const size_t off = (size_t)k * (size_t)w->n_cap;
         r[k] = w->r + off, z[k] = w->z + off, p[k] = w->p + off, q[k] = w->q + off;
@@ -499,8 +553,20 @@ void lub_pcg_solve_multi(lub_pcg_work *w, const lub_csr *A, int nrhs, const doub
             finish(&res[k], LUB_SOLVE_OK, 0, 0.0);
             continue;
         }
+        start[ns++] = k;
+    }
+    if (o->warm_start && ns > 1) {
+        /* the initial residuals share one pass over A, like the products below */
+        const double *bs[LUB_PCG_MAX_RHS];
+        double *xs[LUB_PCG_MAX_RHS], *rs[LUB_PCG_MAX_RHS], rrs[LUB_PCG_MAX_RHS];
+        for (int a = 0; a < ns; a++) bs[a] = b[start[a]], xs[a] = x[start[a]], rs[a] = r[start[a]];
+        residual_multi(A, ns, bs, xs, rs, rrs);
+        for (int a = 0; a < ns; a++) rr[start[a]] = rrs[a];
+    }
+    for (int a = 0; a < ns; a++) {
+        const int k = start[a];
         if (o->warm_start) {
-            rr[k] = residual(A, b[k], x[k], r[k]);
+            if (ns == 1) rr[k] = residual(A, b[k], x[k], r[k]);
         } else {
             memset(x[k], 0, (size_t)n * sizeof *x[k]);
             memcpy(r[k], b[k], (size_t)n * sizeof *r[k]);

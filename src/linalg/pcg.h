@@ -122,8 +122,8 @@ void lub_pcg_solve(lub_pcg_work *w, const lub_csr *A, const double *b, double *x
 
 /* Solve A x_k = b_k for nrhs (1 to LUB_PCG_MAX_RHS) right-hand sides: one CG each, with the
  * same results as nrhs calls of lub_pcg_solve (to round-off of the parallel sums; exactly on
- * one thread), but with their matrix products fused into one pass over A.  res[k] per
- * right-hand side. */
+ * one thread), but with their matrix products (and, with a warm start, their initial
+ * residuals) fused into one pass over A.  res[k] per right-hand side. */
 void lub_pcg_solve_multi(lub_pcg_work *w, const lub_csr *A, int nrhs, const double *const *b,
                          double *const *x, const lub_pcg_options *o, lub_solve_result *res);
 

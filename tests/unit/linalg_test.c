@@ -1274,6 +1274,20 @@ static void test_pcg_multi(void)
         }
         /* they did stop at different iterations: the warm start one first */
         CHECK(it[2] < it[0] && it[2] < it[1]);
+        /* two right-hand sides (their initial residuals in one pass, as three's): the same */
+        {
+            double *y[2] = {x[0], x[1]};
+            const double *bb2[2] = {b[0], b[2]};
+            lub_solve_result r2[2];
+            memset(y[0], 0, n * sizeof *y[0]);
+            memcpy(y[1], x2, n * sizeof *y[1]);
+            lub_pcg_solve_multi(&w, &A, 2, bb2, y, &o, r2);
+            CHECK(r2[0].converged && r2[0].iterations == it[0]);
+            CHECK(r2[1].converged && r2[1].iterations == it[2]);
+            CHECK_NEAR(r2[0].residual, r[0].residual, 1e-13 * r[0].residual + 1e-300);
+            CHECK_NEAR(r2[1].residual, r[2].residual, 1e-13 * r[2].residual + 1e-300);
+            CHECK(rel_err(n, y[1], x[2]) <= 1e-13);
+        }
         printf("  %s, 3 right-hand sides: %d, %d, %d iterations, as alone\n", t ? "amg" : "jacobi",
                it[0], it[1], it[2]);
         /* a zero and a non-finite right-hand side beside a normal one */
