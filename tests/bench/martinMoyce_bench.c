@@ -6,14 +6,18 @@
  * The front of the particle column is the largest x of the fluid particles within 2 l0 of
  * the floor, plus l0/2 (particles are the centres of cells of size l0).  It reports, for
  * 1 <= T <= 3, how far the front is from the band spanned by the two experiment series
- * (each interpolated linearly in T) in units of the scatter between them (issue 4 asks for
- * "within the scatter between the two experimental series up to T = 3").
+ * (each interpolated linearly in T), in Z, and how often that is more than the scatter
+ * between them there (issue 4 asks for "within the scatter between the two experimental
+ * series up to T = 3").  The distance is given in Z, not in units of the scatter: where the
+ * two series cross, their scatter is near 0 and the ratio says nothing.
  *
  * Finding (a = 0.1 m, 20 and 40 particles across the column, same result within 1%; the
  * tutorial tutorials/damBreakMartinMoyce, a = 0.146 m, 16 and 40 across, likewise): the
- * front moves at the measured speed but leads the data by 0.19-0.27 in Z from T ~ 0.5 on, as
- * if it had started dT = 0.2-0.24 earlier; unchanged with the standard gradient, without the
- * collision model or without the pressure predictor.
+ * front moves at the measured speed but leads the data by 0.19-0.28 in Z from the series'
+ * first point (T = 0.83) on, as if it had started dT = 0.2-0.24 earlier; unchanged with the
+ * standard gradient, without the collision model or without the pressure predictor.  The
+ * start of the collapse and its energy agree with references independent of the
+ * experiments (tests/cases/martinMoyce, tutorials/README.md).
  *
  *     build/bench/martinMoyce_bench [particles across the column, default 20]
  */
@@ -89,7 +93,7 @@ static int report(double across)
 
     const double dt = 5e-4, tscale = sqrt(2 * g / a);
     int ok = 1, checked = 0, outside = 0;
-    double worst = 0;
+    double worst = 0, worst_scatter = 0, worst_T = 0; /* largest distance from the band */
     char msg[512];
     long bad;
     for (int k = 1; ok && k * dt * tscale <= 3.0 + 1e-9; k++) {
@@ -105,14 +109,15 @@ static int report(double across)
         if (T < 1.0 || !series_at(&t, 1.125, T, &Z1) || !series_at(&t, 2.25, T, &Z2)) continue;
         double lo = fmin(Z1, Z2), hi = fmax(Z1, Z2), scatter = hi - lo;
         double dev = Z < lo ? lo - Z : Z > hi ? Z - hi : 0; /* outside the band */
-        if (dev / fmax(scatter, 1e-12) > worst) worst = dev / fmax(scatter, 1e-12);
+        if (dev > worst) worst = dev, worst_scatter = scatter, worst_T = T;
         if (dev > scatter) outside++;
         checked++;
         if (k % 20 == 0) printf("  %8.3f %8.3f %8.3f %8.3f\n", T, Z, Z1, Z2);
     }
     printf("# Martin & Moyce: %d times compared for 1 <= T <= 3, %d outside the band widened "
-           "by the scatter (worst: %.2f x scatter)\n",
-           checked, outside, worst);
+           "by the scatter; largest distance from the band %.3f in Z (at T = %.2f, where the "
+           "series differ by %.3f)\n",
+           checked, outside, worst, worst_T, worst_scatter);
     lub_table_free(&t);
     lub_mps_free(&m);
     lub_particles_free(&P);
