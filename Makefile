@@ -97,7 +97,14 @@ $(BUILD)/tests/%_test: $(BUILD)/obj/tests/unit/%_test.o $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
-tests: all $(TEST_BINS)
+# The allocation counter of tests/cases/allocation (an LD_PRELOAD library; not in the
+# AddressSanitizer build, whose runtime owns the allocator).
+ALLOC_COUNT := $(if $(SANITIZE),,$(BUILD)/tests/liballoccount.so)
+$(BUILD)/tests/liballoccount.so: tests/tools/alloccount.c $(FLAGS_STAMP)
+	@mkdir -p $(dir $@)
+	$(CC) -std=c11 -O2 -g -Wall -Wextra -fPIC -shared -o $@ $<
+
+tests: all $(TEST_BINS) $(ALLOC_COUNT)
 
 $(BUILD)/bench/%_bench: $(BUILD)/obj/tests/bench/%_bench.o $(LIB)
 	@mkdir -p $(dir $@)

@@ -190,8 +190,11 @@ static int coarse_factor(lub_amg *g, const lub_csr *A)
     const int n = A->n;
     size_t need = (size_t)n * (size_t)n;
     if (need > g->dense_cap || !g->dense) {
-        g->dense = lub_realloc(g->dense, (need ? need : 1) * sizeof *g->dense);
-        g->dense_cap = need;
+        /* with headroom (as grow_int): the coarsest size changes by a few rows from step to
+         * step, and growing it to the exact size would reallocate whenever it grows */
+        const size_t m = (size_t)n + (size_t)n / 8 + 16;
+        g->dense = lub_realloc(g->dense, m * m * sizeof *g->dense);
+        g->dense_cap = m * m;
     }
     double *D = g->dense;
     memset(D, 0, need * sizeof *D);
