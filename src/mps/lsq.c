@@ -31,10 +31,14 @@ int lub_lsq_terms(int dim, int order)
 const char *lub_lsq_status_name(lub_lsq_status s)
 {
     switch (s) {
-    case LUB_LSQ_OK: return "ok";
-    case LUB_LSQ_TOO_FEW: return "too few neighbours";
-    case LUB_LSQ_SINGULAR: return "singular moment matrix";
-    case LUB_LSQ_EMPTY: return "no neighbour within re";
+    case LUB_LSQ_OK:
+        return "ok";
+    case LUB_LSQ_TOO_FEW:
+        return "too few neighbours";
+    case LUB_LSQ_SINGULAR:
+        return "singular moment matrix";
+    case LUB_LSQ_EMPTY:
+        return "no neighbour within re";
     }
     return "unknown";
 }
@@ -144,8 +148,7 @@ lub_lsq_result lub_lsq_interpolate(const lub_lsq_options *o, const double xt[3],
     const int dim = o->dim;
     if ((dim != 2 && dim != 3) || (o->order != 1 && o->order != 2) || !(o->l0 > 0) ||
         !(o->re > 0) || nf < 1 || nf > MF)
-        lub_bug("lsq: dim %d, order %d, l0 %g, re %g, %d fields", dim, o->order, o->l0, o->re,
-                nf);
+        lub_bug("lsq: dim %d, order %d, l0 %g, re %g, %d fields", dim, o->order, o->l0, o->re, nf);
     const double rcond_min = o->rcond_min > 0 ? o->rcond_min : LUB_LSQ_RCOND_MIN;
     const int mmax = lub_lsq_terms(dim, o->order);
     const double il0 = 1.0 / o->l0, re2 = o->re * o->re;

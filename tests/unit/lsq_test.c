@@ -44,8 +44,8 @@ static size_t jittered_lattice(int dim, double l0, const double centre[3], doubl
                 if (n >= NMAX) return n;
                 int ijk[3] = {a, b, c};
                 for (int d = 0; d < 3; d++)
-                    px[d][n] = d < dim ? centre[d] + l0 * (ijk[d] + jitter * (2 * urand() - 1))
-                                       : 0.0;
+                    px[d][n] =
+                        d < dim ? centre[d] + l0 * (ijk[d] + jitter * (2 * urand() - 1)) : 0.0;
                 n++;
             }
     return n;
@@ -104,16 +104,16 @@ static const double *const F[4] = {fld[0], fld[1], fld[2], fld[3]};
 
 /* Max relative errors of value, gradient and second derivatives over ntarget random points
  * inside the inner part of the cloud. */
-static void exactness(int dim, int order, int deg, double l0, const double centre[3],
-                      int ntarget, double *ev, double *eg, double *eh, int *bad_status)
+static void exactness(int dim, int order, int deg, double l0, const double centre[3], int ntarget,
+                      double *ev, double *eg, double *eh, int *bad_status)
 {
     const double re = 3.1 * l0;
     size_t n = jittered_lattice(dim, l0, centre, 6 * l0, 0.3);
     poly P[3];
     const double L = 10 * l0;
-    P[0] = random_poly(dim, deg, 1.2, L);   /* u [m/s] */
-    P[1] = random_poly(dim, deg, 0.05, L);  /* v */
-    P[2] = random_poly(dim, deg, 3e5, L);   /* p [Pa] */
+    P[0] = random_poly(dim, deg, 1.2, L);  /* u [m/s] */
+    P[1] = random_poly(dim, deg, 0.05, L); /* v */
+    P[2] = random_poly(dim, deg, 3e5, L);  /* p [Pa] */
     fill_fields(n, 3, P, centre);
     lub_lsq_options o = lub_lsq_defaults(dim, l0, re);
     o.order = order;
