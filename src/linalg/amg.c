@@ -14,6 +14,7 @@ void lub_amg_init(lub_amg *g)
     g->theta = 0.5;
     g->alpha = 1.8;
     g->coarse_max = 400;
+    g->dense_budget = 180.0;
     g->cycle = 2;
     for (int l = 0; l < LUB_AMG_MAX_LEVELS; l++) lub_csr_init(&g->lev[l].own);
 }
@@ -35,6 +36,14 @@ void lub_amg_free(lub_amg *g)
     free(g->dense);
     free(g->mark);
     memset(g, 0, sizeof *g);
+}
+
+int lub_amg_dense_max(const lub_amg *g, int n)
+{
+    if (!(g->dense_budget > 0)) return g->coarse_max;
+    int m = (int)cbrt(3.0 * g->dense_budget * (double)n);
+    if (m < 64) m = 64;
+    return m < g->coarse_max ? m : g->coarse_max;
 }
 
 static void grow_int(int **p, int *cap, int n)
@@ -240,6 +249,7 @@ int lub_amg_setup(lub_amg *g, const lub_csr *A)
     g->nblocks = g->blocks > 0 ? g->blocks : omp_get_max_threads();
     if (g->nblocks > LUB_AMG_MAX_BLOCKS) g->nblocks = LUB_AMG_MAX_BLOCKS;
     const lub_csr *M = A;
+    const int dense_max = lub_amg_dense_max(g, A->n);
     for (int l = 0;; l++) {
         lub_amg_level *lv = &g->lev[l];
         lv->A = M;
@@ -255,7 +265,7 @@ int lub_amg_setup(lub_amg *g, const lub_csr *A)
             }
         }
         g->nlev = l + 1;
-        if (n <= g->coarse_max) return coarse_factor(g, M);
+        if (n <= dense_max) return coarse_factor(g, M);
         smoother_values(lv); /* every level but a dense coarsest one is smoothed */
         grow_int(&lv->agg, &lv->agg_cap, n);
         lv->nc = aggregate(M, g->theta, lv->agg, g->nblocks);

@@ -10,7 +10,11 @@
  *     with them; the nodes left over join the aggregate of their strongest neighbour; done
  *     in the smoother's blocks of rows at once (in parallel), each on its own rows;
  *   - piecewise-constant prolongation P, Galerkin coarse matrix A_c = P^T A P;
- *   - levels until at most coarse_max unknowns, solved by a dense Cholesky;
+ *   - levels until at most coarse_max unknowns, solved by a dense Cholesky; and until the
+ *     Cholesky factor, computed at every set-up, costs at most a tenth of a solve's work on
+ *     the finest level (lub_amg_dense_max): a system of 2,600 unknowns (the reduced wedge at
+ *     h0/6) stopped at a dense level of about 370 unknowns whose factor took most of the
+ *     pressure solve, now one level more (below);
  *   - one cycle per application: forward Gauss-Seidel from 0, coarse correction scaled by
  *     alpha (over-correction, which plain aggregation needs: its coarse space is too smooth
  *     to represent the error at the scale of an aggregate), backward Gauss-Seidel.  The
@@ -63,7 +67,10 @@ typedef struct lub_amg_level {
 
 typedef struct lub_amg {
     double theta, alpha; /* strength threshold, coarse-correction scaling */
-    int coarse_max;      /* largest coarsest level for the dense Cholesky */
+    int coarse_max;      /* largest coarsest level for the dense Cholesky (see also
+                          * lub_amg_dense_max) */
+    double dense_budget; /* the dense factor's multiply-adds per unknown of the finest
+                          * level, at most (lub_amg_dense_max); 0: no such limit */
     int cycle;           /* 1: V-cycle, 2: W-cycle (cycles on each coarse level) */
     int blocks;          /* smoother blocks: 0 = one per OpenMP thread */
     int nblocks;         /* used by the current set-up */
@@ -81,7 +88,17 @@ typedef struct lub_amg {
     int mark_cap;
 } lub_amg;
 
-/* theta 0.5, alpha 1.8, coarse_max 400. */
+/* The largest coarsest level solved by the dense Cholesky for a finest level of n unknowns:
+ * min(coarse_max, max(64, cbrt(3 dense_budget n))), or coarse_max when dense_budget is 0.
+ * The factor costs m^3/3 multiply-adds at every set-up; a solve on the finest level about
+ * 1,800 n (10 iterations of a cycle that reads its matrix about 6 times, 30 entries a row),
+ * and dense_budget = 180 keeps the factor within a tenth of that: m = 111 for n = 2,600, 157
+ * for the dam break's 7,200, 311 for the thesis wedge's 56,000 (whose coarsest level, 168,
+ * is unchanged).  Measured (two threads): the reduced wedge at h0/6 (900 steps), pressure
+ * solve 7.1 -> 2.3 s, 7.5 -> 7.8 iterations a step; the reduced soft EHL 10.3 -> 3.9 s. */
+int lub_amg_dense_max(const lub_amg *g, int n);
+
+/* theta 0.5, alpha 1.8, coarse_max 400, dense_budget 180. */
 void lub_amg_init(lub_amg *g);
 void lub_amg_free(lub_amg *g);
 

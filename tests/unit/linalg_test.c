@@ -744,8 +744,8 @@ static void test_amg_preconditioner(void)
     int ic0 = iterations_2d(m, LUB_PRECOND_IC0, 1e-8);
     CHECK(amg < ic0);
     printf("  2-D Poisson 80x80: amg %d iterations (%d levels), ic0 %d\n", amg, w.amg.nlev, ic0);
-    /* one level: exact */
-    CHECK(iterations_2d(15, LUB_PRECOND_AMG, 1e-12) == 1);
+    /* one level (64 unknowns, below lub_amg_dense_max's floor): exact */
+    CHECK(iterations_2d(8, LUB_PRECOND_AMG, 1e-12) == 1);
     /* no off-diagonal couplings, n > coarse_max: nothing to aggregate, the single level is
      * smoothed by Gauss-Seidel, which is exact for a diagonal matrix */
     int nd = 1000;
@@ -855,6 +855,62 @@ static void test_amg_fused_residual(void)
     lub_csr_free(&A);
 }
 
+/* The dense coarsest level: its factor, computed at every set-up (m^3/3 multiply-adds), costs
+ * at most dense_budget multiply-adds per unknown of the finest level (m the largest such
+ * size, not below 64, not above coarse_max), and the coarsening stops at the first level
+ * that small; with dense_budget 0, coarse_max alone decides. */
+static void test_amg_dense_limit(void)
+{
+    lub_amg g;
+    lub_amg_init(&g);
+    int ok = 1;
+    for (int n = 1; n <= 2000000; n = n * 3 / 2 + 1) {
+        const int m = lub_amg_dense_max(&g, n);
+        const double budget = g.dense_budget * n;
+        if (m > 64 && m < g.coarse_max)
+            ok &= (double)m * m * m / 3 <= budget && (m + 1.0) * (m + 1) * (m + 1) / 3 > budget;
+        ok &= m >= 64 && m <= g.coarse_max;
+        ok &= m == g.coarse_max || m == 64 || (double)m * m * m / 3 <= budget;
+    }
+    CHECK(ok);
+    CHECK(lub_amg_dense_max(&g, 2600) == 111 && lub_amg_dense_max(&g, 56000) == 311);
+    CHECK(lub_amg_dense_max(&g, 10) == 64 && lub_amg_dense_max(&g, 10000000) == 400);
+    g.dense_budget = 0;
+    CHECK(lub_amg_dense_max(&g, 2600) == 400);
+    lub_amg_free(&g);
+
+    /* the hierarchy: 2-D Poisson, 2,025 unknowns: level 1 (356 unknowns) is dense by
+     * coarse_max alone, but its factor (15 M multiply-adds) would cost 41 times the budget
+     * (180 x 2,025): one level more, dense at most 103; both solve in a few iterations */
+    lub_csr A;
+    lub_csr_init(&A);
+    poisson2d(&A, 45);
+    double *b = malloc(A.n * sizeof *b), *x = malloc(A.n * sizeof *x);
+    for (int i = 0; i < A.n; i++) b[i] = rnd() - 0.5;
+    for (int budget = 0; budget < 2; budget++) {
+        lub_pcg_work w;
+        lub_pcg_work_init(&w);
+        if (!budget) w.amg.dense_budget = 0;
+        lub_pcg_options o = lub_pcg_defaults();
+        o.precond = LUB_PRECOND_AMG;
+        lub_solve_result r;
+        lub_pcg_solve(&w, &A, b, x, &o, &r);
+        const int dmax = lub_amg_dense_max(&w.amg, A.n), L = w.amg.nlev;
+        const int nc = w.amg.lev[L - 1].A->n, nprev = L > 1 ? w.amg.lev[L - 2].A->n : 0;
+        CHECK(r.converged);
+        CHECK(!w.amg.coarse_gs && w.amg.dense_n == nc);
+        CHECK(nc <= dmax && nprev > dmax);
+        CHECK(dmax == (budget ? 103 : 400) && L == (budget ? 3 : 2));
+        printf("  2-D Poisson 45x45, dense_budget %g: %d levels, the dense one %d unknowns, %d "
+               "iterations to 1e-8\n",
+               w.amg.dense_budget, L, nc, r.iterations);
+        lub_pcg_work_free(&w);
+    }
+    free(b);
+    free(x);
+    lub_csr_free(&A);
+}
+
 /* PCG iterations to 1e-10 on the MPS-like matrix (random right-hand side) with AMG: cycle 1
  * (V) or 2 (W), coarse_max as given; the hierarchy's levels in *nlev. */
 static int amg_iterations(const lub_csr *A, const double *b, int cycle, int coarse_max, int *nlev)
@@ -865,6 +921,7 @@ static int amg_iterations(const lub_csr *A, const double *b, int cycle, int coar
     lub_pcg_work_init(&w);
     w.amg.blocks = 2;
     w.amg.coarse_max = coarse_max;
+    w.amg.dense_budget = 0; /* coarse_max alone decides */
     lub_pcg_options o = lub_pcg_defaults();
     o.precond = LUB_PRECOND_AMG;
     o.tolerance = 1e-10;
@@ -1360,6 +1417,7 @@ int main(void)
     RUN(test_amg_preconditioner);
     RUN(test_amg_fused_residual);
     RUN(test_amg_cycles);
+    RUN(test_amg_dense_limit);
     RUN(test_pcg_work_reuse_across_sizes);
     RUN(test_mps_like_matrix_all_solvers);
     RUN(test_cholmod_poisson);
