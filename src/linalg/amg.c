@@ -271,7 +271,9 @@ int lub_amg_setup(lub_amg *g, const lub_csr *A)
         lv->nc = aggregate(M, g->theta, lv->agg, g->nblocks);
         if (lv->nc > 0.9 * n || l == LUB_AMG_MAX_LEVELS - 1) {
             /* no real coarsening (e.g. no off-diagonal couplings): this level is the
-             * coarsest, smoothed instead of solved */
+             * coarsest, solved by the dense Cholesky if coarse_max allows (the cost budget
+             * gives way: the exact solve is better than none), else smoothed */
+            if (n <= g->coarse_max) return coarse_factor(g, M);
             g->coarse_gs = 1;
             return 0;
         }

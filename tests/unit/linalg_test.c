@@ -908,6 +908,30 @@ static void test_amg_dense_limit(void)
     }
     free(b);
     free(x);
+
+    /* a level that does not coarsen (a diagonal matrix: no couplings) above the budget but
+     * within coarse_max is still solved exactly by the dense factor: PCG in one iteration */
+    const int nd = 200;
+    lub_csr_begin(&A, nd);
+    for (int i = 0; i < nd; i++) lub_csr_set_row_length(&A, i, 1);
+    lub_csr_alloc(&A);
+    for (int i = 0; i < nd; i++) *lub_csr_row_col(&A, i) = i, *lub_csr_row_val(&A, i) = 1.0 + i;
+    lub_csr_finish(&A);
+    double *u = malloc(nd * sizeof *u), *v = calloc(nd, sizeof *v);
+    for (int i = 0; i < nd; i++) u[i] = 1.0;
+    lub_pcg_work w;
+    lub_pcg_work_init(&w);
+    lub_pcg_options o = lub_pcg_defaults();
+    o.precond = LUB_PRECOND_AMG;
+    o.tolerance = 1e-12;
+    lub_solve_result r;
+    lub_pcg_solve(&w, &A, u, v, &o, &r);
+    CHECK(lub_amg_dense_max(&w.amg, nd) == 64);
+    CHECK(w.amg.nlev == 1 && !w.amg.coarse_gs && w.amg.dense_n == nd);
+    CHECK(r.converged && r.iterations == 1);
+    lub_pcg_work_free(&w);
+    free(u);
+    free(v);
     lub_csr_free(&A);
 }
 
