@@ -102,6 +102,7 @@ void lub_neighbours_set_box(lub_neighbours *nb, const double lo[3], const double
 void lub_neighbours_free(lub_neighbours *nb)
 {
     free(nb->start);
+    free(nb->end);
     free(nb->j);
     for (int d = 0; d < 3; d++) free(nb->dx[d]), free(nb->xs[d]);
     free(nb->w);
@@ -144,7 +145,8 @@ static void reserve_particles(lub_neighbours *nb, size_t n)
                   (unsigned)(UINT32_MAX - 1));
     if (n <= nb->cap_n && nb->start) return;
     size_t cap = (size_t)(n * HEADROOM) + 16;
-    nb->start = lub_realloc(nb->start, (cap + 1) * sizeof *nb->start);
+    nb->start = lub_realloc(nb->start, cap * sizeof *nb->start);
+    nb->end = lub_realloc(nb->end, cap * sizeof *nb->end);
     nb->perm = lub_realloc(nb->perm, cap * sizeof *nb->perm);
     nb->cell = lub_realloc(nb->cell, cap * sizeof *nb->cell);
     nb->spos = lub_realloc(nb->spos, cap * sizeof *nb->spos);
@@ -418,34 +420,42 @@ static inline double dist2(int dim, const double *const xs[3], size_t k, const d
     return r2;
 }
 
-/* Count the pairs of every particle into start[i + 1].  The particle itself is among the
+/* The particles of storage block b of nblocks (neighbours.h, Storage): [*i0, *i1). */
+static inline void block_range(size_t n, int b, int nblocks, size_t *i0, size_t *i1)
+{
+    *i0 = n * (size_t)b / (size_t)nblocks;
+    *i1 = n * (size_t)(b + 1) / (size_t)nblocks;
+}
+
+static inline int has_list(const lub_neighbours *nb, size_t i)
+{
+    return !nb->list_kind || (nb->list_kinds >> nb->list_kind[i] & 1u);
+}
+
+/* Count the pairs of every block into count[b].  The particle itself is among the
  * candidates once (own cell, no shift) at distance 0 when its position is finite.
  *
  * The particle loops here and in the solver split the particles into halves (static
- * schedule), although the halves' work differs (lists for some kinds only): handing out
- * chunks as threads come free (tried: dynamic, 512) cut the threads' waiting, but each thread
- * then wrote and read particles all over the arrays, and the pressure solve that follows ran
- * 3-24% slower on the thesis wedge (mostly about 10%), a net loss.  The same half of the
- * particles on the same thread in every phase keeps the data in that core's caches. */
-static void count_sweep(lub_neighbours *nb)
+ * schedule; here one block per thread, the same halves), although the halves' work differs
+ * (lists for some kinds only): handing out chunks as threads come free (tried: dynamic, 512)
+ * cut the threads' waiting, but each thread then wrote and read particles all over the
+ * arrays, and the pressure solve that follows ran 3-24% slower on the thesis wedge (mostly
+ * about 10%), a net loss.  The same half of the particles on the same thread in every phase
+ * keeps the data in that core's caches. */
+static void count_sweep(lub_neighbours *nb, int nblocks, size_t *count)
 {
     const size_t n = nb->n;
     const int dim = nb->dim;
     const double rs2 = nb->rs * nb->rs;
     const double *const xs[3] = {nb->xs[0], nb->xs[1], nb->xs[2]};
-    const uint8_t *lk = nb->list_kind;
-    const unsigned kinds = nb->list_kinds;
-#pragma omp parallel
-    {
+#pragma omp parallel for schedule(static, 1)
+    for (int b = 0; b < nblocks; b++) {
         segment seg[MAX_SEGMENTS];
         int ns = 0;
-        size_t last_cell = (size_t)-1;
-#pragma omp for schedule(static)
-        for (size_t i = 0; i < n; i++) {
-            if (lk && !(kinds >> lk[i] & 1u)) {
-                nb->start[i + 1] = 0;
-                continue;
-            }
+        size_t last_cell = (size_t)-1, i0, i1, total = 0;
+        block_range(n, b, nblocks, &i0, &i1);
+        for (size_t i = i0; i < i1; i++) {
+            if (!has_list(nb, i)) continue;
             const size_t c = nb->cell[i], ki = nb->spos[i];
             if (c != last_cell) ns = cell_segments(nb, c, seg), last_cell = c;
             const double xi[3] = {xs[0][ki], xs[1][ki], dim == 3 ? xs[2][ki] : 0.0};
@@ -460,8 +470,9 @@ static void count_sweep(lub_neighbours *nb)
             }
             double d[3];
             const double p0[3] = {-xi[0], -xi[1], -xi[2]};
-            nb->start[i + 1] = m - (dist2(dim, xs, ki, p0, d) < rs2);
+            total += m - (dist2(dim, xs, ki, p0, d) < rs2);
         }
+        count[b] = total;
     }
 }
 
@@ -486,12 +497,14 @@ static inline size_t store_candidates(const double *const xs[3], const segment *
     return m;
 }
 
-/* Store the pairs: the sorted index k, displacement and squared distance of every candidate
- * are written at the next free place, which advances only for a pair (no unpredictable
- * branch; the write is skipped once the particle's range is full, so a thread never writes
- * into another particle's range); then the particle's pairs get their (T-6) weight and
- * particle index. */
-static void fill_sweep(lub_neighbours *nb)
+/* Store the pairs of block b from place place[b] on, within room[b] entries: the sorted
+ * index k, displacement and squared distance of every candidate are written at the next
+ * free place, which advances only for a pair (no unpredictable branch; nothing is written
+ * beyond the block's room, so a thread never writes into another block's); then the
+ * particle's pairs get their (T-6) weight and particle index.  count[b] becomes the block's
+ * pairs; returns 1 if a block had not the room for them (its lists are then incomplete). */
+static int fill_sweep(lub_neighbours *nb, int nblocks, const size_t *place, const size_t *room,
+                      size_t *count)
 {
     const size_t n = nb->n;
     const int dim = nb->dim;
@@ -501,17 +514,21 @@ static void fill_sweep(lub_neighbours *nb)
     const uint32_t *restrict perm = nb->perm;
     double *restrict DX = nb->dx[0], *restrict DY = nb->dx[1], *restrict DZ = nb->dx[2];
     double *restrict W = nb->w;
-    int mismatch = 0;
-#pragma omp parallel reduction(| : mismatch)
-    {
+    int overflow = 0;
+#pragma omp parallel for schedule(static, 1) reduction(| : overflow)
+    for (int b = 0; b < nblocks; b++) {
         segment seg[MAX_SEGMENTS];
         int ns = 0;
-        size_t last_cell = (size_t)-1;
-#pragma omp for schedule(static)
-        for (size_t i = 0; i < n; i++) {
-            const size_t end = nb->start[i + 1];
-            size_t m = nb->start[i];
-            if (m == end) continue; /* no list wanted (or no neighbours) */
+        size_t last_cell = (size_t)-1, i0, i1;
+        block_range(n, b, nblocks, &i0, &i1);
+        const size_t lim = place[b] + room[b];
+        size_t m = place[b];
+        for (size_t i = i0; i < i1; i++) {
+            nb->start[i] = m;
+            if (!has_list(nb, i)) {
+                nb->end[i] = m;
+                continue;
+            }
             const size_t c = nb->cell[i], ki = nb->spos[i];
             if (c != last_cell) ns = cell_segments(nb, c, seg), last_cell = c;
             const double xi[3] = {xs[0][ki], xs[1][ki], dim == 3 ? xs[2][ki] : 0.0};
@@ -519,32 +536,67 @@ static void fill_sweep(lub_neighbours *nb)
             for (int s = 0; s < ns; s++) {
                 const double p[3] = {seg[s].s[0] - xi[0], seg[s].s[1] - xi[1], seg[s].s[2] - xi[2]};
                 if (dim == 2)
-                    m = store_candidates(xs, &seg[s], p, ki, m, end, rs2, J, DX, DY, DZ, W, 2);
+                    m = store_candidates(xs, &seg[s], p, ki, m, lim, rs2, J, DX, DY, DZ, W, 2);
                 else
-                    m = store_candidates(xs, &seg[s], p, ki, m, end, rs2, J, DX, DY, DZ, W, 3);
+                    m = store_candidates(xs, &seg[s], p, ki, m, lim, rs2, J, DX, DY, DZ, W, 3);
+            }
+            if (m > lim) {
+                /* out of room: the caller counts and fills again */
+                overflow = 1;
+                nb->end[i] = m = lim;
+                for (size_t r = i + 1; r < i1; r++) nb->start[r] = nb->end[r] = lim;
+                break;
             }
             /* the particle's pairs at once: r^2 becomes the (T-6) weight (in a loop that
              * vectorises), the sorted index the particle index */
-            const size_t me = m < end ? m : end;
-            for (size_t q = m0; q < me; q++) W[q] = lub_mps_weight_pair(sqrt(W[q]), inv_re, re);
-            for (size_t q = m0; q < me; q++) J[q] = perm[J[q]];
-            if (m != end) mismatch = 1;
+            for (size_t q = m0; q < m; q++) W[q] = lub_mps_weight_pair(sqrt(W[q]), inv_re, re);
+            for (size_t q = m0; q < m; q++) J[q] = perm[J[q]];
+            nb->end[i] = m;
         }
+        count[b] = m - place[b];
     }
-    if (mismatch) lub_bug("neighbour search: the counting and storing sweeps disagree");
+    return overflow;
+}
+
+/* The blocks' places one after the other, each with the given room; returns the extent. */
+static size_t place_blocks(int nblocks, const size_t *room, size_t *place)
+{
+    size_t at = 0;
+    for (int b = 0; b < nblocks; b++) place[b] = at, at += room[b];
+    return at;
 }
 
 size_t lub_neighbours_build(lub_neighbours *nb, size_t n, double *const x[3])
 {
     size_t escaped = lub_neighbours_bin(nb, n, x);
-    /* Two sweeps (count, then store) keep the lists in one contiguous CSR array in the
-     * particle order, whatever the number of threads. */
-    nb->start[0] = 0;
-    count_sweep(nb);
-    for (size_t i = 0; i < n; i++) nb->start[i + 1] += nb->start[i];
-    nb->npairs = nb->start[n];
-    reserve_pairs(nb, nb->npairs);
-    fill_sweep(nb);
+    int nblocks = omp_get_max_threads();
+    if (nblocks > LUB_NEIGHBOURS_MAX_BLOCKS) nblocks = LUB_NEIGHBOURS_MAX_BLOCKS;
+    if (nblocks < 1) nblocks = 1;
+    size_t place[LUB_NEIGHBOURS_MAX_BLOCKS], room[LUB_NEIGHBOURS_MAX_BLOCKS];
+    size_t count[LUB_NEIGHBOURS_MAX_BLOCKS];
+    int filled = 0;
+    if (nb->nblocks == nblocks) {
+        /* one sweep: each block in the room of its last count with a margin (the counts of
+         * the thesis wedge's halves change by well under a percent from step to step) */
+        for (int b = 0; b < nblocks; b++)
+            room[b] = nb->block_pairs[b] + nb->block_pairs[b] / 32 + 1024;
+        reserve_pairs(nb, place_blocks(nblocks, room, place));
+        filled = !fill_sweep(nb, nblocks, place, room, count);
+    }
+    if (!filled) {
+        /* count first: every block gets its exact room */
+        count_sweep(nb, nblocks, room);
+        reserve_pairs(nb, place_blocks(nblocks, room, place));
+        if (fill_sweep(nb, nblocks, place, room, count))
+            lub_bug("neighbour search: the counting and storing sweeps disagree");
+        for (int b = 0; b < nblocks; b++)
+            if (count[b] != room[b])
+                lub_bug("neighbour search: the counting and storing sweeps disagree");
+        nb->ncounted++;
+    }
+    nb->npairs = 0;
+    for (int b = 0; b < nblocks; b++) nb->npairs += count[b], nb->block_pairs[b] = count[b];
+    nb->nblocks = nblocks;
     return escaped;
 }
 
@@ -555,7 +607,7 @@ static inline void update_particle(lub_neighbours *nb, double *const x[3], size_
 {
     const double re = nb->re;
     const double xi[3] = {x[0][i], x[1][i], dim == 3 ? x[2][i] : 0.0};
-    for (size_t k = nb->start[i]; k < nb->start[i + 1]; k++) {
+    for (size_t k = nb->start[i]; k < nb->end[i]; k++) {
         const size_t j = nb->j[k];
         double r2 = 0.0;
         for (int d = 0; d < dim; d++) {

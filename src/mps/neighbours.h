@@ -7,12 +7,12 @@
  *     ...
  *     size_t escaped = lub_neighbours_build(&nb, n, P->x);            every step
  *     for (size_t i = 0; i < nb.n; i++)
- *         for (size_t k = nb.start[i]; k < nb.start[i + 1]; k++)
+ *         for (size_t k = nb.start[i]; k < nb.end[i]; k++)
  *             j = nb.j[k], r_ij = (nb.dx[0][k], nb.dx[1][k], nb.dx[2][k]), w_ij = nb.w[k]
  *     lub_neighbours_free(&nb);                                       at the end
  *
- * Lists are full (j is in i's list and i in j's), in the caller's particle order (CSR: the
- * neighbours of i are entries start[i] .. start[i+1]-1), each list ordered by neighbouring
+ * Lists are full (j is in i's list and i in j's), in the caller's particle order (the
+ * neighbours of i are entries start[i] .. end[i]-1), each list ordered by neighbouring
  * cell, then by index within a cell: ascending j once the particles are sorted into cell
  * order (lub_neighbours_bin, or _order with h = 0; no periodic direction, whose wrapped cells
  * come first), nearly so while few have moved to another cell since (the rows of a matrix
@@ -44,7 +44,16 @@
  *
  * Lists of some particles only: set nb.list_kind (a kind per particle, e.g. P->kind) and
  * nb.list_kinds (a bit per kind) before the build; the others get empty lists.
- * OpenMP over particles; the lists do not depend on the number of threads.
+ *
+ * Storage: the particles are split into one block of consecutive particles per thread, and
+ * each block's lists follow each other in the arrays from the block's place on; unused
+ * entries may lie between two blocks (so end[i] is not always start[i + 1]).  A block's
+ * place comes from its pair count in the previous build with a margin, so that a build is a
+ * single sweep over the candidates; only when there is no previous build (or it had another
+ * number of blocks) or a block outgrows its margin does a counting sweep come first, which
+ * gives every block its exact place (nb.ncounted counts those builds).
+ * OpenMP over particles; the lists (their pairs and order) do not depend on the number of
+ * threads, only where they are stored.
  */
 #ifndef LUB_MPS_NEIGHBOURS_H
 #define LUB_MPS_NEIGHBOURS_H
@@ -59,6 +68,8 @@
  * grid, such as mps/opt.c, must look that far). */
 #define LUB_NEIGHBOURS_MAX_REACH      2
 #define LUB_NEIGHBOURS_FINE_CELLS_MAX 16777216.0
+/* Storage blocks of the lists (see Storage above): one per thread, at most this many. */
+#define LUB_NEIGHBOURS_MAX_BLOCKS 256
 
 typedef struct {
     int dim;   /* 2 or 3 */
@@ -77,10 +88,11 @@ typedef struct {
     /* results of the last build */
     size_t n;        /* particles */
     size_t npairs;   /* entries in the lists (each pair twice) */
-    size_t *start;   /* [n + 1] */
-    uint32_t *j;     /* [npairs] neighbour index */
-    double *dx[3];   /* [npairs] r_j - r_i, minimum image; dx[2] is NULL in 2-D */
-    double *w;       /* [npairs] w(|r_ij|, re) */
+    size_t *start;   /* [n] first entry of particle i's list */
+    size_t *end;     /* [n] one past its last */
+    uint32_t *j;     /* [cap_pairs] neighbour index */
+    double *dx[3];   /* [cap_pairs] r_j - r_i, minimum image; dx[2] is NULL in 2-D */
+    double *w;       /* [cap_pairs] w(|r_ij|, re) */
     uint32_t *perm;  /* [n] cell order: perm[k] = index of the k-th particle */
     size_t nescaped; /* particles outside the box in a non-periodic direction, or non-finite */
 
@@ -99,6 +111,11 @@ typedef struct {
     uint32_t *tcount;   /* [threads x ncells] per-thread cell counts of the binning */
     size_t cap_tcount;
     size_t cap_n, cap_pairs, cap_cells;
+    /* storage blocks (see Storage above): their number in the last build (0: none yet) and
+     * their pair counts, the next build's estimates */
+    int nblocks;
+    size_t block_pairs[LUB_NEIGHBOURS_MAX_BLOCKS];
+    size_t ncounted; /* builds that needed the counting sweep */
 
     /* sort order of lub_neighbours_order: rows of spacing order_h (0: cell order) */
     double order_h;

@@ -59,7 +59,7 @@ void lub_mps_pnd(const lub_neighbours *nb, const lub_mps_mask *mask, double *pnd
         if (!takes_part(mv.ikind, mv.i, i)) continue;
         double s = 0.0;
         /* (T-4) */
-        for (size_t k = nb->start[i]; k < nb->start[i + 1]; k++)
+        for (size_t k = nb->start[i]; k < nb->end[i]; k++)
             if (takes_part(mv.jkind, mv.j, nb->j[k])) s += nb->w[k];
         pnd[i] = s;
     }
@@ -76,7 +76,7 @@ void lub_mps_laplacian(const lub_neighbours *nb, const lub_mps_mask *mask, doubl
         if (!takes_part(mv.ikind, mv.i, i)) continue;
         const double phii = phi[i];
         double s = 0.0;
-        for (size_t k = nb->start[i]; k < nb->start[i + 1]; k++) {
+        for (size_t k = nb->start[i]; k < nb->end[i]; k++) {
             const size_t j = nb->j[k];
             if (takes_part(mv.jkind, mv.j, j)) s += (phi[j] - phii) * nb->w[k];
         }
@@ -89,7 +89,7 @@ static inline double min_pressure(const lub_neighbours *nb, const mask_view *mv,
                                   size_t i)
 {
     double ph = p[i];
-    for (size_t k = nb->start[i]; k < nb->start[i + 1]; k++) {
+    for (size_t k = nb->start[i]; k < nb->end[i]; k++) {
         const size_t j = nb->j[k];
         if (nb->w[k] > 0.0 && takes_part(mv->jkind, mv->j, j) && p[j] < ph) ph = p[j];
     }
@@ -106,7 +106,7 @@ static inline void gradient_sums(const lub_neighbours *nb, const mask_view *mv, 
     b[0] = b[1] = b[2] = 0.0;
     for (int a = 0; a < 3; a++)
         for (int c = 0; c < 3; c++) m[a][c] = 0.0;
-    for (size_t k = nb->start[i]; k < nb->start[i + 1]; k++) {
+    for (size_t k = nb->start[i]; k < nb->end[i]; k++) {
         const size_t j = nb->j[k];
         const double w = nb->w[k];
         if (w == 0.0 || !takes_part(mv->jkind, mv->j, j)) continue;

@@ -173,7 +173,7 @@ static void begin_rows(lub_mps *m, int nrows)
     for (int r = 0; r < nrows; r++) {
         size_t i = (size_t)m->prow[r];
         int len = 1;
-        for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++)
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++)
             if (nb->w[q] > 0 && m->row[nb->j[q]] >= 0) len++;
         lub_csr_set_row_length(&m->A, r, len);
     }
@@ -216,7 +216,7 @@ static void smooth_fluid(lub_mps *m, double *const f[3], double *const out[3])
     for (size_t i = 0; i < P->n; i++) {
         if (P->kind[i] != LUB_FLUID) continue;
         double sw = 0, s[3] = {0, 0, 0};
-        for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
             const size_t j = nb->j[q];
             const double w = nb->w[q];
             if (w <= 0 || P->kind[j] != LUB_FLUID) continue;
@@ -251,7 +251,7 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
         for (size_t i = 0; i < n; i++) {
             if (P->kind[i] != LUB_FLUID || (fix && fix[i])) continue;
             double acc[3] = {0, 0, 0};
-            for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+            for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
                 double w = nb->w[q];
                 size_t j = nb->j[q];
                 double f = P->kind[j] == LUB_DUMMY ? gm : 1.0;
@@ -281,7 +281,7 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
             double *val = lub_csr_row_val(&m->A, r);
             double wsum = 0, rhs[3] = {0, 0, 0};
             int e = 0, dg = -1; /* the diagonal in column order (the lists are sorted) */
-            for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+            for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
                 double w = nb->w[q];
                 if (w <= 0) continue;
                 size_t j = nb->j[q];
@@ -361,7 +361,7 @@ static void free_surface(lub_mps *m)
         uint8_t s = 0;
         if (P->kind[i] != LUB_DUMMY) {
             double c[3] = {0, 0, 0}, wsum = 0, wpres = 0;
-            for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+            for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
                 double w = nb->w[q];
                 wsum += w;
                 if (P->kind[nb->j[q]] != LUB_DUMMY) wpres += w;
@@ -496,7 +496,7 @@ assemble:
         double wsum = 0, bfix = 0;
         int e = 0, dg = -1; /* the diagonal in column order (the lists are sorted) */
         uint8_t anchored = 0;
-        for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
             double w = nb->w[q];
             size_t j = nb->j[q];
             if (w <= 0 || P->kind[j] == LUB_DUMMY) continue;
@@ -571,7 +571,7 @@ assemble:
                 continue;
             }
             double f = src * (m->pnd[i] - m->n0);
-            for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+            for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
                 size_t j = nb->j[q];
                 if (nb->w[q] > 0 && P->kind[j] != LUB_DUMMY) f += c * nb->w[q] * P->p[j];
             }
@@ -601,7 +601,7 @@ static void collision(lub_mps *m, double dt)
         double acc[3] = {0, 0, 0};
         /* a fixed-band particle keeps its given velocity (it still stops the others) */
         if (P->kind[i] == LUB_FLUID && !(m->fixed && m->fixed[i])) {
-            for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+            for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
                 const size_t j = nb->j[q];
                 double v[3];
                 const double r2 = lub_neighbours_r(nb, x, i, j, v); /* now, not at the build */
@@ -725,7 +725,7 @@ static int through(const lub_mps *m, double dt, size_t i, unsigned patch, double
     /* centroids of the patch's wall and dummy neighbours, covariance of the wall particles */
     double cw[3] = {0, 0, 0}, cd[3] = {0, 0, 0}, S[3][3] = {{0}};
     int nw = 0, nd = 0;
-    for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+    for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
         const size_t j = nb->j[q];
         if (P->kind[j] == LUB_FLUID || P->patch[j] != patch) continue;
         double v[3];
@@ -801,7 +801,7 @@ static int through(const lub_mps *m, double dt, size_t i, unsigned patch, double
     int sides = 0;
     size_t w = i;
     double lw2 = INFINITY, tw = 0;
-    for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+    for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
         const size_t j = nb->j[q];
         if (P->kind[j] != LUB_WALL || P->patch[j] != patch) continue;
         double v[3];
@@ -839,7 +839,7 @@ static long through_wall(const lub_mps *m, double dt, unsigned *patch, double *t
     for (size_t i = 0; i < P->n; i++) {
         if (P->kind[i] != LUB_FLUID || (long)i >= first) continue;
         if (m->fixed && m->fixed[i]) continue; /* given: lub_mps_buried */
-        for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
             const size_t d = nb->j[q];
             if (P->kind[d] != LUB_DUMMY) continue;
             if (!(lub_neighbours_r(nb, x, d, i, NULL) < g2)) continue;
@@ -873,7 +873,7 @@ size_t lub_mps_buried(const lub_mps *m, double dt, uint8_t *flag)
 #pragma omp parallel for schedule(static) reduction(+ : n)
     for (size_t i = 0; i < P->n; i++) {
         if (P->kind[i] != LUB_FLUID || !m->fixed[i]) continue;
-        for (size_t q = nb->start[i]; q < nb->start[i + 1]; q++) {
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
             const size_t d = nb->j[q];
             if (P->kind[d] != LUB_DUMMY) continue;
             if (!(lub_neighbours_r(nb, x, d, i, NULL) < g2)) continue;

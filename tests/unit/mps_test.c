@@ -64,6 +64,25 @@ static int bpair_cmp(const void *a, const void *b)
     return p->d[0] < q->d[0] ? -1 : p->d[0] > q->d[0];
 }
 
+/* Whether two builds hold the same lists (pairs, order, displacements and weights, bit for
+ * bit), wherever in their arrays they are stored. */
+static int same_lists(const lub_neighbours *a, const lub_neighbours *b)
+{
+    if (a->n != b->n || a->npairs != b->npairs || a->dim != b->dim) return 0;
+    for (size_t i = 0; i < a->n; i++) {
+        const size_t len = a->end[i] - a->start[i];
+        if (b->end[i] - b->start[i] != len) return 0;
+        const size_t p = a->start[i], q = b->start[i];
+        if (len == 0) continue;
+        if (memcmp(a->j + p, b->j + q, len * sizeof *a->j) != 0 ||
+            memcmp(a->w + p, b->w + q, len * sizeof *a->w) != 0)
+            return 0;
+        for (int d = 0; d < a->dim; d++)
+            if (memcmp(a->dx[d] + p, b->dx[d] + q, len * sizeof(double)) != 0) return 0;
+    }
+    return 1;
+}
+
 /* Compare the lists with a brute-force search over all pairs (minimum image by rounding in
  * periodic directions).  Returns the number of particles whose lists differ. */
 static size_t compare_brute(const lub_neighbours *nb, const cloud *c, const double lo[3],
@@ -85,7 +104,7 @@ static size_t compare_brute(const lub_neighbours *nb, const cloud *c, const doub
             }
             if (r2 < rs * rs) a[na].j = (uint32_t)j, memcpy(a[na].d, d, sizeof d), na++;
         }
-        size_t nl = nb->start[i + 1] - nb->start[i];
+        size_t nl = nb->end[i] - nb->start[i];
         int ok = nl == na;
         b = realloc(b, (nl + 1) * sizeof *b);
         for (size_t m = 0; m < nl; m++) {
@@ -207,9 +226,7 @@ static void check_search(int dim, size_t n, const double lo[3], const double hi[
     lub_neighbours_build(&nb, c.n, c.x);
     omp_set_num_threads(nt);
     CHECK(nb1.npairs == nb.npairs);
-    CHECK(memcmp(nb1.start, nb.start, (c.n + 1) * sizeof *nb.start) == 0);
-    CHECK(memcmp(nb1.j, nb.j, nb.npairs * sizeof *nb.j) == 0);
-    CHECK(memcmp(nb1.w, nb.w, nb.npairs * sizeof *nb.w) == 0);
+    CHECK(same_lists(&nb1, &nb));
     lub_neighbours_free(&nb1);
     lub_neighbours_free(&nb);
     cloud_free(&c);
@@ -305,11 +322,12 @@ static void test_search_escaped(void)
     lub_neighbours_init(&nb, 2, 0.2, 0.0, lo, hi, px);
     CHECK(lub_neighbours_build(&nb, c.n, c.x) == 4);
     CHECK(nb.npairs == 2);
-    CHECK(nb.start[1] == 1 && nb.j[0] == 1);
-    CHECK(nb.start[2] == 2 && nb.j[1] == 0);
+    CHECK(nb.end[0] - nb.start[0] == 1 && nb.j[nb.start[0]] == 1);
+    CHECK(nb.end[1] - nb.start[1] == 1 && nb.j[nb.start[1]] == 0);
+    for (size_t i = 2; i < c.n; i++) CHECK(nb.end[i] == nb.start[i]);
     /* no particles at all */
     CHECK(lub_neighbours_build(&nb, 0, c.x) == 0);
-    CHECK(nb.npairs == 0 && nb.start[0] == 0);
+    CHECK(nb.npairs == 0);
     CHECK(lub_neighbours_update(&nb, c.x) == 0);
     lub_neighbours_free(&nb);
     cloud_free(&c);
@@ -489,7 +507,7 @@ static void bin_threads(double height)
         same &= memcmp(a.perm, b.perm, n * sizeof *a.perm) == 0;
         same &= memcmp(a.cell, b.cell, n * sizeof *a.cell) == 0;
         same &= memcmp(a.cell_start, b.cell_start, (a.ncells + 1) * sizeof *a.cell_start) == 0;
-        same &= memcmp(a.j, b.j, a.npairs * sizeof *a.j) == 0;
+        same &= same_lists(&a, &b);
     }
     omp_set_num_threads(nt);
     CHECK(same);
@@ -531,7 +549,7 @@ static void check_list_kinds(int dim, const int per[3])
     lub_neighbours_build(&part, c.n, c.x);
     size_t bad = 0, pairs = 0, ndummy = 0;
     for (size_t i = 0; i < c.n; i++) {
-        const size_t nf = full.start[i + 1] - full.start[i], np = part.start[i + 1] - part.start[i];
+        const size_t nf = full.end[i] - full.start[i], np = part.end[i] - part.start[i];
         if (c.kind[i] == LUB_DUMMY) {
             ndummy++;
             bad += np != 0;
@@ -611,8 +629,7 @@ static void test_sorted_lists(void)
         CHECK(compare_brute(&nb, &c, lo, hi, per) == 0);
         int ascending = 1;
         for (size_t i = 0; i < c.n; i++)
-            for (size_t q = nb.start[i] + 1; q < nb.start[i + 1]; q++)
-                ascending &= nb.j[q - 1] < nb.j[q];
+            for (size_t q = nb.start[i] + 1; q < nb.end[i]; q++) ascending &= nb.j[q - 1] < nb.j[q];
         CHECK(ascending);
         CHECK(nb.npairs > 10 * c.n);
         free(scratch);
@@ -875,7 +892,7 @@ static void check_lsmps_jittered(int dim)
     double minerr = 0;
     for (size_t i = 0; i < c.n; i++) {
         int ismin = 1;
-        for (size_t k = nb.start[i]; k < nb.start[i + 1]; k++) ismin &= p[nb.j[k]] >= p[i];
+        for (size_t k = nb.start[i]; k < nb.end[i]; k++) ismin &= p[nb.j[k]] >= p[i];
         if (!ismin) continue;
         nmin++;
         for (int d = 0; d < dim; d++) minerr = fmax(minerr, fabs(g[d][i] - G[d]));
@@ -1104,6 +1121,56 @@ static void test_no_realloc(void)
     cloud_free(&c);
 }
 
+/* The single sweep (neighbours.h, Storage): a build after one on nearly the same particles
+ * stores the lists without counting; one whose blocks outgrow their room (the particles
+ * pressed together: twice the pairs) counts first, as does one on another number of
+ * threads; the lists are exact every time (brute force) and, on two threads, the same as on
+ * one. */
+static void test_one_sweep(void)
+{
+    const double lo[3] = {0, 0, 0}, hi[3] = {1, 1, 0};
+    const int per[3] = {1, 0, 0};
+    const double re = 0.05;
+    cloud c;
+    random_cloud(&c, 2, 3000, lo, hi, per, re);
+    const int nt = omp_get_max_threads();
+    omp_set_num_threads(2);
+    lub_neighbours nb;
+    lub_neighbours_init(&nb, 2, re, 0.0, lo, hi, per);
+    lub_neighbours_build(&nb, c.n, c.x);
+    CHECK(nb.ncounted == 1 && nb.nblocks == 2);
+    CHECK(compare_brute(&nb, &c, lo, hi, per) == 0);
+    for (int rep = 0; rep < 3; rep++) {
+        for (size_t i = 0; i < c.n; i++) c.x[1][i] += 1e-3 * re * (rnd() - 0.5);
+        lub_neighbours_build(&nb, c.n, c.x);
+        CHECK(compare_brute(&nb, &c, lo, hi, per) == 0);
+    }
+    CHECK(nb.ncounted == 1);
+    /* every particle moved to 0.7 of its height: about 1 / 0.7 times the pairs */
+    const size_t before = nb.npairs;
+    for (size_t i = 0; i < c.n; i++) c.x[1][i] = lo[1] + 0.7 * (c.x[1][i] - lo[1]);
+    lub_neighbours_build(&nb, c.n, c.x);
+    CHECK(nb.npairs > before + before / 4);
+    CHECK(nb.ncounted == 2);
+    CHECK(compare_brute(&nb, &c, lo, hi, per) == 0);
+    /* one thread: one block, counted; the same lists as two blocks */
+    lub_neighbours one;
+    lub_neighbours_init(&one, 2, re, 0.0, lo, hi, per);
+    omp_set_num_threads(1);
+    lub_neighbours_build(&one, c.n, c.x);
+    lub_neighbours_build(&nb, c.n, c.x);
+    CHECK(one.nblocks == 1 && nb.nblocks == 1 && nb.ncounted == 3);
+    CHECK(same_lists(&one, &nb));
+    omp_set_num_threads(2);
+    lub_neighbours_build(&nb, c.n, c.x);
+    CHECK(nb.ncounted == 4 && nb.nblocks == 2);
+    CHECK(same_lists(&one, &nb));
+    omp_set_num_threads(nt);
+    lub_neighbours_free(&one);
+    lub_neighbours_free(&nb);
+    cloud_free(&c);
+}
+
 int main(void)
 {
     lub_set_quiet(1);
@@ -1132,5 +1199,6 @@ int main(void)
     RUN(test_mask);
     RUN(test_update);
     RUN(test_no_realloc);
+    RUN(test_one_sweep);
     return test_summary();
 }
