@@ -116,17 +116,30 @@ static int read_samples_line(const char *path, long *S, double *A, double *B)
     return found;
 }
 
-/* A run that starts inside the averaging window of o continues the average of the earlier
- * run it restarts from: the p.dat of the latest earlier start time whose last sample is the
- * start step (see the header). */
-static void wall_pressure_resume(fo *o, lubfoam_run *r)
+static void wall_pressure_not_continued(const fo *o, const lubfoam_run *r, const char *dir)
+{
+    lub_warning("function '%s': no earlier average ending at the start time %g was found under "
+                "%s: the wall pressure is averaged from t = %g on, not from timeStart %g",
+                o->name, r->t, dir, r->t, o->t0);
+}
+
+/* A run that starts inside the averaging window of o (at its first step included) continues
+ * the average of the earlier run it restarts from: the p.dat of the latest earlier start time
+ * whose last sample is the start step (see the header).  Returns 1 if it did. */
+static int wall_pressure_resume(fo *o, lubfoam_run *r)
 {
     double eps = 0.5 * r->dt + 1e-12 * fabs(r->t);
-    if (!(r->t > o->t0 + eps) || !(o->t0 < o->t1)) return;
+    if (!(r->t >= o->t0 - eps) || !(r->t <= o->t1 + eps) || !(o->t0 < o->t1)) return 0;
+    /* at the window's first step, an earlier run held one sample at most (the start step's,
+     * which the caller takes again from the start state): nothing to warn about */
+    const int at_first = r->t <= o->t0 + eps;
     char dir[LUB_PATH_MAX];
     lub_case_pathf(&r->cs, dir, "postProcessing/%s", o->name);
     DIR *dp = opendir(dir);
-    if (!dp) return;
+    if (!dp) {
+        if (!at_first) wall_pressure_not_continued(o, r, dir);
+        return 0;
+    }
     double best_t = -INFINITY;
     char best[LUB_PATH_MAX] = "";
     long bestS = 0;
@@ -149,11 +162,8 @@ static void wall_pressure_resume(fo *o, lubfoam_run *r)
     }
     closedir(dp);
     if (!best[0]) {
-        lub_warning("function '%s': no earlier average ending at the start time %g was found "
-                    "under %s: the wall pressure is averaged from t = %g on, not from "
-                    "timeStart %g",
-                    o->name, r->t, dir, r->t, o->t0);
-        return;
+        if (!at_first) wall_pressure_not_continued(o, r, dir);
+        return 0;
     }
     lub_table t;
     lub_table_read(&t, best);
@@ -175,7 +185,10 @@ static void wall_pressure_resume(fo *o, lubfoam_run *r)
     o->tlast = r->t;
     lub_message("function '%s': continues the average of %s (%ld steps from t = %g)", o->name, best,
                 bestS, bestA);
+    return 1;
 }
+
+static void wall_pressure(fo *o, lubfoam_run *r);
 
 lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
 {
@@ -228,7 +241,10 @@ lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
                 lub_node_error(d, "function '%s': %d bins", name, o->nbins);
             o->sum = lub_calloc((size_t)o->nbins, sizeof *o->sum);
             o->count = lub_calloc((size_t)o->nbins, sizeof *o->count);
-            wall_pressure_resume(o, r);
+            /* a restart that continues no earlier average samples its start state, as the
+             * run that wrote it did after that step (wall_pressure keeps to the window) */
+            if (!wall_pressure_resume(o, r) && r->step > 0 && r->step % o->interval == 0)
+                wall_pressure(o, r);
         }
     }
     if (r->has_elastic) {
