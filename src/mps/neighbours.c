@@ -576,8 +576,8 @@ size_t lub_neighbours_build(lub_neighbours *nb, size_t n, double *const x[3])
     size_t count[LUB_NEIGHBOURS_MAX_BLOCKS];
     int filled = 0;
     if (nb->nblocks == nblocks) {
-        /* one sweep: each block in the room of its last count with a margin (the counts of
-         * the thesis wedge's halves change by well under a percent from step to step) */
+        /* one sweep: each block in the room of its last count with a margin (in the thesis
+         * wedge's 96-step sample and the dam break no build after the first outgrew it) */
         for (int b = 0; b < nblocks; b++)
             room[b] = nb->block_pairs[b] + nb->block_pairs[b] / 32 + 1024;
         reserve_pairs(nb, place_blocks(nblocks, room, place));
