@@ -170,6 +170,14 @@ static void reserve_pairs(lub_neighbours *nb, size_t npairs)
     nb->cap_pairs = cap;
 }
 
+/* Particles [*i0, *i1) of chunk b of nblocks equal chunks of n: the binning's per-thread
+ * chunks and the lists' storage blocks (neighbours.h, Storage). */
+static inline void block_range(size_t n, int b, int nblocks, size_t *i0, size_t *i1)
+{
+    *i0 = n * (size_t)b / (size_t)nblocks;
+    *i1 = n * (size_t)(b + 1) / (size_t)nblocks;
+}
+
 /* Bring a coordinate of a periodic direction into [lo, lo + L); NaN stays NaN. */
 static inline double wrap(double x, double lo, double L)
 {
@@ -236,7 +244,8 @@ size_t lub_neighbours_bin(lub_neighbours *nb, size_t n, double *const x[3])
     for (int t = 0; t < nt; t++) {
         uint32_t *cnt = nb->tcount + (size_t)t * ncells;
         memset(cnt, 0, ncells * sizeof *cnt);
-        const size_t i0 = n * (size_t)t / (size_t)nt, i1 = n * (size_t)(t + 1) / (size_t)nt;
+        size_t i0, i1;
+        block_range(n, t, nt, &i0, &i1);
         for (size_t i = i0; i < i1; i++) {
             double xi[3] = {0, 0, 0};
             esc[t] += (size_t)search_position(nb, x, i, xi);
@@ -278,7 +287,8 @@ size_t lub_neighbours_bin(lub_neighbours *nb, size_t n, double *const x[3])
 #pragma omp parallel for schedule(static, 1) num_threads(nt) if (nt > 1)
     for (int t = 0; t < nt; t++) {
         uint32_t *next = nb->tcount + (size_t)t * ncells;
-        const size_t i0 = n * (size_t)t / (size_t)nt, i1 = n * (size_t)(t + 1) / (size_t)nt;
+        size_t i0, i1;
+        block_range(n, t, nt, &i0, &i1);
         for (size_t i = i0; i < i1; i++) {
             const size_t kk = next[nb->cell[i]]++;
             double xi[3];
@@ -418,13 +428,6 @@ static inline double dist2(int dim, const double *const xs[3], size_t k, const d
     double r2 = d[0] * d[0] + d[1] * d[1];
     if (dim == 3) d[2] = xs[2][k] + p[2], r2 += d[2] * d[2];
     return r2;
-}
-
-/* The particles of storage block b of nblocks (neighbours.h, Storage): [*i0, *i1). */
-static inline void block_range(size_t n, int b, int nblocks, size_t *i0, size_t *i1)
-{
-    *i0 = n * (size_t)b / (size_t)nblocks;
-    *i1 = n * (size_t)(b + 1) / (size_t)nblocks;
 }
 
 static inline int has_list(const lub_neighbours *nb, size_t i)
@@ -587,11 +590,9 @@ size_t lub_neighbours_build(lub_neighbours *nb, size_t n, double *const x[3])
         /* count first: every block gets its exact room */
         count_sweep(nb, nblocks, room);
         reserve_pairs(nb, place_blocks(nblocks, room, place));
-        if (fill_sweep(nb, nblocks, place, room, count))
-            lub_bug("neighbour search: the counting and storing sweeps disagree");
-        for (int b = 0; b < nblocks; b++)
-            if (count[b] != room[b])
-                lub_bug("neighbour search: the counting and storing sweeps disagree");
+        int mismatch = fill_sweep(nb, nblocks, place, room, count);
+        for (int b = 0; b < nblocks; b++) mismatch |= count[b] != room[b];
+        if (mismatch) lub_bug("neighbour search: the counting and storing sweeps disagree");
         nb->ncounted++;
     }
     nb->npairs = 0;
