@@ -17,12 +17,15 @@
  *              (n: samples; multi-resolution: the wall particles in the part of x their
  *              level owns, as the elasticWall load); rewritten at every write time and at
  *              the end, with a second line "# samples S steps from t = A to t = B" (the
- *              steps averaged so far).  A run restarted inside the window continues the
- *              average: it reads the p.dat of an earlier start whose last sample is the step
- *              it restarts from (sum = p n per bin, exact to round-off) and writes the whole
- *              window's mean under its own start time.  If no such table exists (the earlier
- *              run was stopped between writing its time folder and its table, or the table
- *              was deleted) it says so and averages from its start time only.
+ *              steps averaged so far); not written while it holds no sample (a run that
+ *              ends before the window or restarts after it), so that the latest start
+ *              time's table is the latest average, as the tutorials' Allruns take it.  A
+ *              run restarted inside the window continues the average: it reads the p.dat
+ *              of an earlier start whose last sample is the step it restarts from (sum =
+ *              p n per bin, exact to round-off) and writes the whole window's mean under
+ *              its own start time.  If no such table exists (the earlier run was stopped
+ *              between writing its time folder and its table, or the table was deleted) it
+ *              says so and averages from its start time only.
  * The cost table (postProcessing/cost/<startTime>/cost.dat) is written by lubFoam itself.
  *
  * With the elasticWall model (constant/models.yaml) a table is always written, every
@@ -325,16 +328,17 @@ void lubfoam_functions_write(lubfoam_functions *F, lubfoam_run *r)
 {
     for (int k = 0; k < F->n; k++) {
         fo *o = &F->f[k];
-        if (o->type != FO_WALLPRESSURE) continue;
+        /* nothing averaged (outside the window): no table, which would hide the earlier
+         * run's average from whoever takes the latest start time's */
+        if (o->type != FO_WALLPRESSURE || !o->samples) continue;
         char path[LUB_PATH_MAX];
         lub_postproc_path(&r->cs, o->name, r->start_name, "p.dat", path);
         lub_atomic_file af;
         FILE *fp = lub_atomic_open(&af, path);
         if (!fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
         lub_table_write_header(fp, "x p n");
-        if (o->samples)
-            fprintf(fp, "# samples %ld steps from t = %.17g to t = %.17g\n", o->samples, o->tfirst,
-                    o->tlast);
+        fprintf(fp, "# samples %ld steps from t = %.17g to t = %.17g\n", o->samples, o->tfirst,
+                o->tlast);
         for (int b = 0; b < o->nbins; b++) {
             if (!o->count[b]) continue;
             double row[3] = {o->from + (b + 0.5) * o->bin, o->sum[b] / (double)o->count[b],
