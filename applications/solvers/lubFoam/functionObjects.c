@@ -24,8 +24,9 @@
  *              of an earlier start whose last sample is the step it restarts from (sum =
  *              p n per bin, exact to round-off) and writes the whole window's mean under
  *              its own start time.  If no such table exists (the earlier run was stopped
- *              between writing its time folder and its table, or the table was deleted) it
- *              says so and averages from its start time only.
+ *              between writing its time folder and its table, or the table was deleted), or
+ *              the one there began before timeStart (changed since), it says so and
+ *              averages from its start time only.
  * The cost table (postProcessing/cost/<startTime>/cost.dat) is written by lubFoam itself.
  *
  * With the elasticWall model (constant/models.yaml) a table is always written, every
@@ -143,8 +144,8 @@ static int wall_pressure_resume(fo *o, lubfoam_run *r)
         if (!at_first) wall_pressure_not_continued(o, r, dir);
         return 0;
     }
-    double best_t = -INFINITY;
-    char best[LUB_PATH_MAX] = "";
+    double best_t = -INFINITY, early_t = -INFINITY, early_A = 0;
+    char best[LUB_PATH_MAX] = "", early[LUB_PATH_MAX] = "";
     long bestS = 0;
     double bestA = 0;
     struct dirent *de;
@@ -158,12 +159,25 @@ static int wall_pressure_resume(fo *o, lubfoam_run *r)
         if (snprintf(path, sizeof path, "%s/%s/p.dat", dir, de->d_name) >= (int)sizeof path)
             continue;
         if (!read_samples_line(path, &S, &A, &B) || fabs(B - r->t) > eps) continue;
+        if (A < o->t0 - eps) {
+            /* an average begun before this window (timeStart changed since): it holds
+             * samples the window excludes, which cannot be taken out again */
+            if (tv > early_t) early_t = tv, early_A = A, snprintf(early, sizeof early, "%s", path);
+            continue;
+        }
         best_t = tv;
         bestS = S;
         bestA = A;
         snprintf(best, sizeof best, "%s", path);
     }
     closedir(dp);
+    if (!best[0] && early[0]) {
+        lub_warning("function '%s': the average of %s began at t = %g, before timeStart %g "
+                    "(changed since that run?): not continued; the wall pressure is averaged "
+                    "from t = %g on",
+                    o->name, early, early_A, o->t0, r->t);
+        return 0;
+    }
     if (!best[0]) {
         if (!at_first) wall_pressure_not_continued(o, r, dir);
         return 0;
