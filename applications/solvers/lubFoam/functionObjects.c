@@ -253,6 +253,11 @@ lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
             o->bin = lub_dict_real_or(d, "bin", 4 * lubfoam_mps0(r)->l0, LUB_POSITIVE);
             o->t0 = lub_dict_real_or(d, "timeStart", 0.0, LUB_NONNEGATIVE);
             o->t1 = lub_dict_real_or(d, "timeEnd", INFINITY, LUB_NONNEGATIVE);
+            if (o->t1 < o->t0)
+                lub_node_error(lub_dict_get(d, "timeEnd"),
+                               "function '%s': timeEnd (%g) is earlier than timeStart (%g): the "
+                               "window would hold no step",
+                               name, o->t1, o->t0);
             o->nbins = (int)ceil((o->to - o->from) / o->bin - 1e-9);
             if (o->nbins < 1 || o->nbins > 10000000)
                 lub_node_error(d, "function '%s': %d bins", name, o->nbins);
