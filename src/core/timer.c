@@ -25,6 +25,24 @@ double lub_load_average(const char *path)
     return load;
 }
 
+int lub_runnable_tasks(const char *path)
+{
+    FILE *f = fopen(path ? path : "/proc/loadavg", "r");
+    if (!f) return -1;
+    double a1, a5, a15;
+    int running = -1, total;
+    if (fscanf(f, "%lf %lf %lf %d/%d", &a1, &a5, &a15, &running, &total) != 5 || running < 0)
+        running = -1;
+    fclose(f);
+    return running;
+}
+
+double lub_load_now(double average, int others)
+{
+    if (!(average >= 0)) return -1.0;
+    return others >= 0 && others < average ? (double)others : average;
+}
+
 int lub_threads_oversubscribed(double load, int cores, int threads, int *fit)
 {
     int free_cores = load >= 0 ? (int)floor(cores - load + 0.5) : cores;

@@ -35,8 +35,19 @@ static inline void lub_timer_stop(lub_timers *t, int k)
     t->seconds[k] += lub_wtime() - t->started[k];
 }
 
-/* The machine's 1-minute load average (/proc/loadavg), or -1 where it cannot be read. */
+/* The machine's 1-minute load average (/proc/loadavg; path: a file of its format), or -1
+ * where it cannot be read. */
 double lub_load_average(const char *path);
+/* The tasks runnable at the moment of reading (R of the fourth field R/T of /proc/loadavg,
+ * which counts the reader), or -1 where it cannot be read. */
+int lub_runnable_tasks(const char *path);
+/* The load other work puts on the machine now: the 1-minute average, but no more than the
+ * `others` tasks of other programs runnable at this moment (-1: unknown).  The average lags:
+ * it still reads 1.5 a few seconds after a two-thread run has ended, which alone made every
+ * run started right after another (a sweep, an Allrun after a build) warn of a busy machine.
+ * A run still going is runnable at any moment (MPS runs do not wait for I/O).  -1 if the
+ * average is unknown. */
+double lub_load_now(double average, int others);
 
 /* Whether `threads` OpenMP threads would share the `cores` cores with other work at load
  * average `load` (taken before the run starts): threads > 1 and load + threads > cores + 0.5.

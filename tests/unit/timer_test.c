@@ -1,5 +1,5 @@
-/* core/timer: the phase timers, the load average and the oversubscription test that lubFoam
- * warns with at start-up. */
+/* core/timer: the phase timers, the load (average and tasks running now) and the oversubscription
+ * test that lubFoam warns with at start-up. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <unistd.h>
@@ -32,12 +32,36 @@ static void test_load_average(void)
     fputs("1.52 0.80 0.40 3/120 4567\n", f);
     fclose(f);
     CHECK_NEAR(lub_load_average(path), 1.52, 1e-15);
+    CHECK(lub_runnable_tasks(path) == 3);
     f = fopen(path, "w");
     fputs("garbage\n", f);
     fclose(f);
     CHECK(lub_load_average(path) == -1.0);
+    CHECK(lub_runnable_tasks(path) == -1);
+    f = fopen(path, "w");
+    fputs("0.90 1.27 1.35\n", f); /* no R/T field */
+    fclose(f);
+    CHECK(lub_runnable_tasks(path) == -1);
     remove(path);
     CHECK(lub_load_average(path) == -1.0); /* missing file */
+    CHECK(lub_runnable_tasks(path) == -1);
+    /* the machine's own file reads, and counts at least this reader */
+    CHECK(lub_runnable_tasks(NULL) >= 1 || lub_runnable_tasks(NULL) == -1);
+}
+
+static void test_load_now(void)
+{
+    /* a two-thread run ended seconds ago: the average still reads 1.5, nothing runs now */
+    CHECK(lub_load_now(1.5, 0) == 0.0);
+    CHECK(!lub_threads_oversubscribed(lub_load_now(1.5, 0), 2, 2, NULL));
+    /* a two-thread run going for minutes: average and count agree */
+    CHECK(lub_load_now(1.95, 2) == 1.95);
+    CHECK(lub_threads_oversubscribed(lub_load_now(1.95, 2), 2, 2, NULL));
+    /* one just started: the average has not caught up, it is taken as it is */
+    CHECK(lub_load_now(0.3, 2) == 0.3);
+    /* unknown count: the average; unknown average: unknown */
+    CHECK(lub_load_now(1.2, -1) == 1.2);
+    CHECK(lub_load_now(-1.0, 3) == -1.0);
 }
 
 static void test_oversubscribed(void)
@@ -64,5 +88,6 @@ int main(void)
     RUN(test_timers);
     RUN(test_load_average);
     RUN(test_oversubscribed);
+    RUN(test_load_now);
     return test_summary();
 }
