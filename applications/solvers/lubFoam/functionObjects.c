@@ -221,18 +221,7 @@ lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
         snprintf(o->name, sizeof o->name, "%s", name);
         o->type = lub_dict_choice(d, "type", types, -1);
         o->interval = lub_dict_int_or(d, "interval", 1, 1, 1L << 40);
-        char path[LUB_PATH_MAX];
-        if (o->type == FO_TOTALS) {
-            lub_postproc_path(&r->cs, name, r->start_name, "totals.dat", path);
-            o->fp = fopen(path, "w");
-            if (!o->fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
-            /* units as probe totals writes them: per unit depth in 2-D */
-            lub_table_write_header(
-                o->fp, r->P.dim == 2 ? "t[s] mass[kg/m] momentumX[kg/s] momentumY[kg/s] "
-                                       "momentumZ[kg/s] kineticEnergy[J/m] fluidParticles"
-                                     : "t[s] mass[kg] momentumX[kg*m/s] momentumY[kg*m/s] "
-                                       "momentumZ[kg*m/s] kineticEnergy[J] fluidParticles");
-        } else {
+        if (o->type != FO_TOTALS) {
             const char *patch = lub_dict_str(d, "patch");
             o->patch = lub_particles_find_patch(&r->P, patch);
             if (o->patch < 0) {
@@ -263,17 +252,36 @@ lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
                 lub_node_error(d, "function '%s': %d bins", name, o->nbins);
             o->sum = lub_calloc((size_t)o->nbins, sizeof *o->sum);
             o->count = lub_calloc((size_t)o->nbins, sizeof *o->count);
+        }
+    }
+    return F;
+}
+
+void lubfoam_functions_start(lubfoam_functions *F, lubfoam_run *r)
+{
+    for (int k = 0; k < F->n; k++) {
+        fo *o = &F->f[k];
+        if (o->type == FO_TOTALS) {
+            char path[LUB_PATH_MAX];
+            lub_postproc_path(&r->cs, o->name, r->start_name, "totals.dat", path);
+            o->fp = fopen(path, "w");
+            if (!o->fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+            /* units as probe totals writes them: per unit depth in 2-D */
+            lub_table_write_header(
+                o->fp, r->P.dim == 2 ? "t[s] mass[kg/m] momentumX[kg/s] momentumY[kg/s] "
+                                       "momentumZ[kg/s] kineticEnergy[J/m] fluidParticles"
+                                     : "t[s] mass[kg] momentumX[kg*m/s] momentumY[kg*m/s] "
+                                       "momentumZ[kg*m/s] kineticEnergy[J] fluidParticles");
+        } else if (!wall_pressure_resume(o, r) && r->step > 0 && r->step % o->interval == 0) {
             /* a restart that continues no earlier average samples its start state, as the
              * run that wrote it did after that step (wall_pressure keeps to the window) */
-            if (!wall_pressure_resume(o, r) && r->step > 0 && r->step % o->interval == 0)
-                wall_pressure(o, r);
+            wall_pressure(o, r);
         }
     }
     if (r->has_elastic) {
         elastic_open(F, r);
         elastic_row(F, r);
     }
-    return F;
 }
 
 static void totals(fo *o, lubfoam_run *r)

@@ -444,6 +444,16 @@ int main(int argc, char **argv)
     lubfoam_check_levels(&r, &geo);
     lub_geometry_free(&geo);
 
+    /* a finished run started again (an Allrun run twice): its dictionaries are checked, but
+     * it writes nothing (no empty tables under postProcessing/ for this start time) */
+    const int nothing_to_run = lub_control_finished(&r.ctl, r.t, 0, r.dt);
+    if (nothing_to_run)
+        lub_message("lubFoam: the start time %s is at or past endTime %g: nothing to run, "
+                    "nothing written (raise endTime in system/controlDict.yaml to continue)",
+                    r.start_name, r.ctl.end_time);
+    else
+        lubfoam_functions_start(fos, &r);
+
     install_stop_handlers();
     const int tty = isatty(STDOUT_FILENO);
     const double wall0 = lub_wtime();
@@ -579,9 +589,9 @@ int main(int argc, char **argv)
             break;
         }
     }
-    if (tty) fputc('\n', stdout);
-    write_cost(&r, steps, lub_wtime() - wall0, pit_sum, vit_sum);
-    if (r.has_elastic) {
+    if (tty && !nothing_to_run) fputc('\n', stdout);
+    if (!nothing_to_run) write_cost(&r, steps, lub_wtime() - wall0, pit_sum, vit_sum);
+    if (r.has_elastic && !nothing_to_run) {
         const lub_mps_elastic *w = &r.elastic;
         lub_message("elasticWall: t %.9g s: mean load %.6g N/m of %.6g (%+.3f%%), h0 %.9g m, "
                     "centre %.9g m, v in [%.6g, %.6g] m, closest approach %.6g m",

@@ -56,9 +56,12 @@ void lubfoam_write(lubfoam_run *r);
  * system/reynoldsRefDict.yaml.  Warnings only. */
 void lubfoam_check_levels(const lubfoam_run *r, const lub_geometry *geo);
 
-/* Function objects (controlDict `functions`). */
+/* Function objects (controlDict `functions`): _read checks their dictionaries, _start opens
+ * their tables under postProcessing/ (a run with no step to take writes none), _execute
+ * after every step, _write at every write time and at the end. */
 typedef struct lubfoam_functions lubfoam_functions;
 lubfoam_functions *lubfoam_functions_read(lubfoam_run *r);
+void lubfoam_functions_start(lubfoam_functions *f, lubfoam_run *r);
 void lubfoam_functions_execute(lubfoam_functions *f, lubfoam_run *r);
 void lubfoam_functions_write(lubfoam_functions *f, lubfoam_run *r);
 void lubfoam_functions_free(lubfoam_functions *f);
