@@ -15,26 +15,20 @@ int lub_timers_add(lub_timers *t, const char *name)
     return t->n++;
 }
 
-double lub_load_average(const char *path)
+double lub_load_average(const char *path, int *runnable)
 {
+    if (runnable) *runnable = -1;
     FILE *f = fopen(path ? path : "/proc/loadavg", "r");
     if (!f) return -1.0;
     double load = -1.0;
-    if (fscanf(f, "%lf", &load) != 1 || !(load >= 0)) load = -1.0;
+    int running = -1;
+    if (fscanf(f, "%lf", &load) != 1 || !(load >= 0))
+        load = -1.0;
+    else if (fscanf(f, "%*f %*f %d/%*d", &running) != 1 || running < 0)
+        running = -1;
+    if (runnable) *runnable = running;
     fclose(f);
     return load;
-}
-
-int lub_runnable_tasks(const char *path)
-{
-    FILE *f = fopen(path ? path : "/proc/loadavg", "r");
-    if (!f) return -1;
-    double a1, a5, a15;
-    int running = -1, total;
-    if (fscanf(f, "%lf %lf %lf %d/%d", &a1, &a5, &a15, &running, &total) != 5 || running < 0)
-        running = -1;
-    fclose(f);
-    return running;
 }
 
 double lub_load_now(double average, int others)

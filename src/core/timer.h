@@ -36,11 +36,9 @@ static inline void lub_timer_stop(lub_timers *t, int k)
 }
 
 /* The machine's 1-minute load average (/proc/loadavg; path: a file of its format), or -1
- * where it cannot be read. */
-double lub_load_average(const char *path);
-/* The tasks runnable at the moment of reading (R of the fourth field R/T of /proc/loadavg,
- * which counts the reader), or -1 where it cannot be read. */
-int lub_runnable_tasks(const char *path);
+ * where it cannot be read; and in *runnable (may be NULL) the tasks runnable at the moment
+ * of reading (R of its fourth field R/T, which counts the reader), or -1. */
+double lub_load_average(const char *path, int *runnable);
 /* The load other work puts on the machine now: the 1-minute average, but no more than the
  * `others` tasks of other programs runnable at this moment (-1: unknown).  The average lags:
  * it still reads 1.5 a few seconds after a two-thread run has ended, which alone made every
@@ -50,7 +48,7 @@ int lub_runnable_tasks(const char *path);
 double lub_load_now(double average, int others);
 
 /* Whether `threads` OpenMP threads would share the `cores` cores with other work at load
- * average `load` (taken before the run starts): threads > 1 and load + threads > cores + 0.5.
+ * `load` (lub_load_now, taken before the run starts): threads > 1 and load + threads > cores + 0.5.
  * Threads that wait for each other at every parallel region then wait for the other work's
  * time slices too: on this project's 2-core machine with two other runs, the reduced wedge
  * took 7.6 us per particle-step on two threads against 2.5 on one (1.9 on two, idle).

@@ -122,8 +122,9 @@ static void check_limits(lubfoam_run *r)
                   r->ctl.max_diffusion * m->l0 * m->l0 / m->c.nu);
 }
 
-/* others_running: the tasks of other programs runnable when lubFoam started (-1: unknown) */
-static void print_header(const lubfoam_run *r, int others_running)
+/* average, others_running: the load average and the tasks of other programs runnable when
+ * lubFoam started (-1: unknown) */
+static void print_header(const lubfoam_run *r, double average, int others_running)
 {
     const lub_mps *m = lubfoam_mps0(r);
     size_t cnt[3] = {0, 0, 0};
@@ -135,7 +136,7 @@ static void print_header(const lubfoam_run *r, int others_running)
                 r->step, m->dim);
     lub_message("Particles: %zu (fluid %zu, wall %zu, dummy %zu), threads %d", r->P.n, cnt[0],
                 cnt[1], cnt[2], omp_get_max_threads());
-    const double average = lub_load_average(NULL), load = lub_load_now(average, others_running);
+    const double load = lub_load_now(average, others_running);
     int fit = 1;
     if (lub_threads_oversubscribed(load, omp_get_num_procs(), omp_get_max_threads(), &fit))
         lub_warning("the machine is busy (load average %.2f, %d tasks of other programs "
@@ -397,10 +398,11 @@ int main(int argc, char **argv)
     };
     lub_args a;
     lub_args_parse(&a, argc, argv, &info, NULL);
-    /* the other programs' runnable tasks, counted before this one starts its OpenMP threads
-     * (the count includes the reader, this thread) */
-    const int runnable = lub_runnable_tasks(NULL),
-              others_running = runnable > 0 ? runnable - 1 : -1;
+    /* the machine's load, read before this program starts its OpenMP threads: the runnable
+     * tasks then count only this thread of it */
+    int runnable;
+    const double load_average = lub_load_average(NULL, &runnable);
+    const int others_running = runnable > 0 ? runnable - 1 : -1;
 
     lubfoam_run r;
     memset(&r, 0, sizeof r);
@@ -440,7 +442,7 @@ int main(int argc, char **argv)
     lubfoam_functions *fos = lubfoam_functions_read(&r);
     lub_dict_finish(r.ctl.dict);
 
-    print_header(&r, others_running);
+    print_header(&r, load_average, others_running);
     check_limits(&r);
     lubfoam_check_levels(&r, &geo);
     lub_geometry_free(&geo);
