@@ -8,7 +8,8 @@
  *     negativePressure: clip         # clip | keep | cavitation
  *     dummyVelocity:    mirror       # mirror (no-slip ghost 2 U - u_i) | wall (U)
  *     pressure:         { alpha: 0, gamma: 0.2, predictor: 0.1 }   # T-9; lub_mps_step
- *     freeSurface:      { beta: 0.97, asymmetry: 0.2 }       # T-12 + geometric test
+ *     freeSurface:      { beta: 0.97, asymmetry: 0.2, test: sector, sectorAngle: 60 }
+ *                       # T-12 + geometric tests (test: sector | centroid | pnd)
  *     neighbourSkin:    0.2
  *     lsmpsDetMin:      1.0e-2
  *     particleOrder:    cells        # cells | rows
@@ -33,6 +34,10 @@
 #include "mps/mps.h"
 #include "mps/operators.h"
 
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
 void lub_mps_config_defaults(lub_mps_config *c)
 {
     memset(c, 0, sizeof *c);
@@ -44,7 +49,9 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->gamma = 0.2;
     c->predictor = 0.1;
     c->beta = 0.97;
+    c->surface_test = LUB_SURFACE_SECTOR;
     c->asymmetry = 0.2;
+    c->cone_cos = cos(M_PI / 6); /* sectorAngle 60 degrees */
     c->skin = 0.0;
     c->lsmps_det_min = LUB_MPS_LSMPS_DET_MIN;
     c->reorder_interval = 1;
@@ -98,7 +105,21 @@ static void read_schemes(lub_mps_config *c, const char *path)
     c->predictor = lub_dict_real_or(p, "predictor", c->predictor, LUB_BETWEEN(0.0, 1.0));
     lub_node *fs = lub_dict_map_or(r, "freeSurface");
     c->beta = lub_dict_real_or(fs, "beta", 0.97, (lub_range){0.0, 1.0, 1, 1});
-    c->asymmetry = lub_dict_real_or(fs, "asymmetry", 0.2, LUB_BETWEEN(0.0, 10.0));
+    static const char *const stest[] = {"sector", "centroid", "pnd", NULL};
+    c->surface_test = lub_dict_choice(fs, "test", stest, LUB_SURFACE_SECTOR);
+    if (c->surface_test != LUB_SURFACE_PND)
+        c->asymmetry = lub_dict_real_or(fs, "asymmetry", 0.2, LUB_BETWEEN(0.0, 10.0));
+    else if (lub_dict_find(fs, "asymmetry"))
+        lub_node_error(lub_dict_find(fs, "asymmetry"),
+                       "freeSurface: 'asymmetry' has no use with test: pnd");
+    if (c->surface_test == LUB_SURFACE_SECTOR)
+        c->cone_cos =
+            cos(0.5 * lub_dict_real_or(fs, "sectorAngle", 60.0, LUB_BETWEEN(10.0, 179.0)) * M_PI /
+                180.0);
+    else if (lub_dict_find(fs, "sectorAngle"))
+        lub_node_error(lub_dict_find(fs, "sectorAngle"),
+                       "freeSurface: 'sectorAngle' belongs to test: sector (the test is '%s')",
+                       stest[c->surface_test]);
     c->skin = lub_dict_real_or(r, "neighbourSkin", 0.0, LUB_BETWEEN(0.0, 1.0));
     c->lsmps_det_min =
         lub_dict_real_or(r, "lsmpsDetMin", LUB_MPS_LSMPS_DET_MIN, (lub_range){0.0, 1.0, 1, 1});

@@ -8,7 +8,8 @@
  *        gradient, which is then added back: u* += dt G / rho)
  *     3. temporary positions r* = r^k + u* dt      (T-8); walls move with their velocity
  *     4. PND n* at r*                              (T-11)
- *     5. free surface: n* < beta n0, refined by a geometric test   (T-12)
+ *     5. free surface: n* < beta n0, refined by geometric tests   (T-12): the neighbours'
+ *        centroid off-centre and an open side (an empty sector or cone around the particle)
  *     6. pressure Poisson equation                 (T-9, T-10), Dirichlet p = 0 on the surface
  *        (with alpha = 0 also on a group of particles that touches no surface particle: its
  *        pressure would be undetermined; st.nisolated)
@@ -53,6 +54,7 @@
 enum { LUB_GRADIENT_STANDARD = 0, LUB_GRADIENT_LSMPS = 1 };
 enum { LUB_VISCOSITY_NONE = 0, LUB_VISCOSITY_EXPLICIT = 1, LUB_VISCOSITY_CN = 2 };
 enum { LUB_NEGATIVE_KEEP = 0, LUB_NEGATIVE_CLIP = 1, LUB_NEGATIVE_CAVITATION = 2 };
+enum { LUB_SURFACE_SECTOR = 0, LUB_SURFACE_CENTROID = 1, LUB_SURFACE_PND = 2 };
 
 typedef struct {
     /* system/schemes.yaml */
@@ -65,8 +67,10 @@ typedef struct {
     double predictor;       /* weight of the newest pressure gradient in the running mean
                                that the viscous predictor feels (0: off; see lub_mps_step) */
     double beta;            /* free surface: n* < beta n0 (T-12) */
-    double asymmetry;       /* geometric test: centroid offset / l0 above which a low-PND
-                               particle is on the surface (0: PND test only) */
+    int surface_test;       /* LUB_SURFACE_*: the geometric test of a low-PND particle */
+    double asymmetry;       /* centroid offset / l0 above which a low-PND particle is on the
+                               surface (centroid and sector tests) */
+    double cone_cos;        /* sector test: cosine of half the opening of the empty sector */
     double skin;            /* neighbour search radius re (1 + skin) */
     double lsmps_det_min;   /* LSMPS fallback threshold */
     int reorder_interval;   /* steps between sorts of the particles (0: never) */

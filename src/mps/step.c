@@ -8,6 +8,10 @@
 #include "mps/mps.h"
 #include "mps/operators.h"
 
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
 const char *const lub_mps_phase_names[] = {
     "neighbourSearch", "viscositySolve", "assembly", "pressureSolve",
     "gradient",        "other",          "output",   NULL};
@@ -343,18 +347,91 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
     return 0;
 }
 
-/* Free surface (T-12): n* < beta n0, kept only when the neighbourhood is one-sided: the
- * weighted centroid of the neighbours is further than `asymmetry` l0 from the particle.
- * This geometric refinement plays the role of the thesis' virtual-light test: an interior
- * particle whose PND dropped (a transient rarefaction) has neighbours all around it.  In a
- * multi-resolution overlap (m->inside, set by mps/opt.c) a particle where the other level's
- * particles fill the neighbourhood is not on a surface, whatever its own PND. */
+/* An open side of particle i: an empty sector (2-D) or cone (3-D) of full opening angle
+ * 2 acos(ccos), holding no neighbour within re of any kind, anywhere around i.
+ *
+ * 2-D exactly: the largest angular gap between consecutive neighbours (sorted by angle) is
+ * at least the opening.  3-D by sampling: the cone of half-angle acos(ccos) around one of 27
+ * axes (the direction away from the neighbours' weighted centroid c, and the 26 lattice
+ * directions) is empty; the 26 directions are within 35.3 degrees of any direction, so an
+ * empty cone of half-angle theta always leaves one of half-angle theta - 35.3 degrees around
+ * some axis, and the direction away from the centroid finds the open side of a flat or
+ * gently curved surface at once. */
+static int open_side(const lub_mps *m, size_t i, const double c[3], double ccos)
+{
+    const lub_neighbours *nb = &m->nb;
+    if (m->dim == 2) {
+        double ang[128];
+        int na = 0;
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+            if (nb->w[q] <= 0) continue;
+            if (na == (int)(sizeof ang / sizeof *ang)) return 0; /* crowded: not a surface */
+            ang[na++] = atan2(nb->dx[1][q], nb->dx[0][q]);
+        }
+        if (na < 2) return 1;
+        for (int k = 1; k < na; k++) { /* insertion sort: a few dozen angles */
+            double v = ang[k];
+            int l = k - 1;
+            while (l >= 0 && ang[l] > v) ang[l + 1] = ang[l], l--;
+            ang[l + 1] = v;
+        }
+        double gap = ang[0] + 2 * M_PI - ang[na - 1];
+        for (int k = 1; k < na; k++) gap = fmax(gap, ang[k] - ang[k - 1]);
+        return gap >= 2 * acos(ccos);
+    }
+    for (int a = 0; a < 27; a++) {
+        double v[3];
+        if (a == 26) {
+            v[0] = -c[0], v[1] = -c[1], v[2] = -c[2];
+        } else {
+            int b = a < 13 ? a : a + 1; /* 0..26 without the centre 13 */
+            v[0] = b % 3 - 1, v[1] = (b / 3) % 3 - 1, v[2] = b / 9 - 1;
+        }
+        double vn = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+        if (vn <= 0) continue;
+        int empty = 1;
+        for (size_t q = nb->start[i]; q < nb->end[i] && empty; q++) {
+            if (nb->w[q] <= 0) continue;
+            double dot = 0, r2 = 0;
+            for (int d = 0; d < 3; d++) {
+                dot += nb->dx[d][q] * v[d];
+                r2 += nb->dx[d][q] * nb->dx[d][q];
+            }
+            if (dot >= ccos * sqrt(r2) * vn) empty = 0;
+        }
+        if (empty) return 1;
+    }
+    return 0;
+}
+
+/* Free surface (T-12): n* < beta n0, refined by a geometric test (freeSurface.test):
+ *
+ *   sector (default): the particle also has an open side, an empty sector (2-D) or cone
+ *     (3-D) of opening sectorAngle around it that holds no particle within re, fluid, wall or
+ *     dummy (open_side).  This is the idea of the thesis' virtual-light test (Shibata: light
+ *     reaches a surface particle from some direction through its neighbours' shadows).  A
+ *     particle inside a full film whose PND dropped (a transient rarefaction, a particle
+ *     beside a curved wall, whose neighbours' centroid is off-centre) has neighbours on every
+ *     side, fluid or wall, with gaps between them of 20-40 degrees: it is not a surface
+ *     particle.  Taken as one (the centroid test did so at a few steps in a hundred in a
+ *     lubricating film), its P = 0 in the film's high-pressure zone drops the whole film's
+ *     pressure to a third at that step (tests/unit/mps_test.c test_surface_film).  The
+ *     sector test is applied after the centroid test, which keeps its cost to the few
+ *     particles with a low PND and an off-centre neighbourhood.
+ *   centroid: the weighted centroid of the neighbours is further than `asymmetry` l0 from
+ *     the particle (alone: the test of the earlier builds).
+ *   pnd: the PND test alone.
+ *
+ * In a multi-resolution overlap (m->inside, set by mps/opt.c) a particle where the other
+ * level's particles fill the neighbourhood is not on a surface, whatever its own PND. */
 static void free_surface(lub_mps *m)
 {
     lub_particles *P = m->P;
     const lub_neighbours *nb = &m->nb;
     const size_t n = P->n;
     const double lim = m->c.beta * m->n0, asym = m->c.asymmetry * m->l0;
+    const int test = m->c.surface_test;
+    const double ccos = m->c.cone_cos;
     size_t ns = 0;
 #pragma omp parallel for schedule(static) reduction(+ : ns)
     for (size_t i = 0; i < n; i++) {
@@ -371,7 +448,12 @@ static void free_surface(lub_mps *m)
                 s = 1; /* no pressure neighbour: nothing to couple to */
             } else if (m->pnd[i] < lim && !(m->inside && m->inside[i])) {
                 double off = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]) / wsum;
-                s = (asym <= 0 || off > asym);
+                if (test == LUB_SURFACE_PND)
+                    s = 1;
+                else
+                    s = (asym <= 0 || off > asym);
+                if (s && test == LUB_SURFACE_SECTOR && P->kind[i] == LUB_FLUID)
+                    s = (uint8_t)open_side(m, i, c, ccos);
             }
         }
         m->surface[i] = s;

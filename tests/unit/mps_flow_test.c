@@ -327,6 +327,115 @@ static void test_step_bearing(void)
     lub_geometry_free(&g);
 }
 
+/* Free-surface detection (src/mps/step.c free_surface) against what the geometry says.
+ *
+ * (a) A full film: the closed channel (no free surface anywhere) with a vacancy of three
+ * particles above one fluid particle (a transient rarefaction: its PND 25% low, its
+ * neighbours' centroid 0.34 l0 off-centre).  It has neighbours on every side within re
+ * (angular gaps below 20 degrees), so it is not a surface particle, nor is any other.  The
+ * centroid test of the earlier builds flags it, and its P = 0 then pins the film's pressure
+ * to zero in the middle of the flow (issue 26: the wall load of single steps at a third of
+ * the others' in the lubricating films).
+ * (b) A layer with a free top (lower wall only, periodic in x, on the lattice): every
+ * particle of the top row is a surface particle, no particle below it is.
+ * Detection runs at r* (step 4-5), so the particles are at rest, without gravity, and one
+ * step of 1 ns hardly moves them. */
+static void surface_flags(lub_particles *P, const lub_geometry *g, lub_mps_config *c, lub_mps *m)
+{
+    c->rho = 1000;
+    c->nu = 1e-6;
+    c->viscosity = LUB_VISCOSITY_CN;
+    c->alpha = 1e-6 / (1e-3 * 1e-3);
+    lub_mps_init(m, P, c, g->dmin, g->dmax, g->periodic);
+    CHECK(run(m, 1e-9, 1) == 0);
+}
+
+static void test_surface_film(void)
+{
+    lub_particles G = {0}, P = {0};
+    lub_geometry g;
+    generate(channel, &G, &g);
+    const double l0 = 0.001;
+    /* the fluid particle nearest the channel's centre, and the vacancy above it */
+    size_t c0 = 0;
+    double best = INFINITY;
+    for (size_t i = 0; i < G.n; i++) {
+        double d = hypot(G.x[0][i] - 0.01, G.x[1][i] - 0.01);
+        if (G.kind[i] == LUB_FLUID && d < best) best = d, c0 = i;
+    }
+    const double xc = G.x[0][c0], yc = G.x[1][c0];
+    lub_particles_init(&P, 2, G.n);
+    for (int k = 0; k < G.npatches; k++) lub_particles_patch(&P, G.patch_names[k]);
+    P.nlevels = G.nlevels;
+    P.levels[0] = G.levels[0];
+    size_t removed = 0;
+    unsigned long long idc = 0;
+    for (size_t i = 0; i < G.n; i++) {
+        double dx = G.x[0][i] - xc, dy = G.x[1][i] - yc;
+        if (G.kind[i] == LUB_FLUID && fabs(dy - l0) < 0.1 * l0 && fabs(dx) < 1.1 * l0) {
+            removed++;
+            continue;
+        }
+        double x[3] = {G.x[0][i], G.x[1][i], 0};
+        size_t j = lub_particles_add(&P, x, G.kind[i], G.patch[i], 0);
+        P.id[j] = G.id[i];
+        if (i == c0) idc = G.id[i];
+    }
+    CHECK(removed == 3);
+    for (int test = LUB_SURFACE_SECTOR; test <= LUB_SURFACE_CENTROID; test++) {
+        lub_mps_config c;
+        lub_mps_config_defaults(&c);
+        c.surface_test = test;
+        lub_mps m;
+        surface_flags(&P, &g, &c, &m);
+        size_t nfluid = 0, at_vacancy = 0;
+        for (size_t i = 0; i < P.n; i++) {
+            nfluid += P.kind[i] == LUB_FLUID && m.surface[i];
+            at_vacancy += P.id[i] == idc && m.surface[i];
+        }
+        printf("  full film with a vacancy, %s test: %zu surface particles (%zu at the vacancy)\n",
+               test == LUB_SURFACE_SECTOR ? "sector" : "centroid", nfluid, at_vacancy);
+        if (test == LUB_SURFACE_SECTOR) CHECK(nfluid == 0);
+        lub_mps_free(&m);
+    }
+    lub_particles_free(&P);
+    lub_particles_free(&G);
+    lub_geometry_free(&g);
+
+    /* (b) the free top of a layer 10 l0 deep */
+    generate("dimension: 2\n"
+             "l0: 0.001\n"
+             "domain: { min: [0, -0.004], max: [0.02, 0.024] }\n"
+             "periodic: [x]\n"
+             "walls:\n"
+             "  lower: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+             "fluid:\n"
+             "  - { type: box, min: [0, 0], max: [0.02, 0.01] }\n",
+             &P, &g);
+    double ytop = -INFINITY;
+    for (size_t i = 0; i < P.n; i++)
+        if (P.kind[i] == LUB_FLUID) ytop = fmax(ytop, P.x[1][i]);
+    lub_mps_config c;
+    lub_mps_config_defaults(&c);
+    lub_mps m;
+    surface_flags(&P, &g, &c, &m);
+    size_t top = 0, top_flagged = 0, below_flagged = 0;
+    for (size_t i = 0; i < P.n; i++) {
+        if (P.kind[i] != LUB_FLUID) continue;
+        if (P.x[1][i] > ytop - 0.5 * l0)
+            top++, top_flagged += m.surface[i];
+        else
+            below_flagged += m.surface[i];
+    }
+    printf("  free layer: %zu of %zu top-row particles on the surface, %zu below\n", top_flagged,
+           top, below_flagged);
+    CHECK(top == 20 && top_flagged == top);
+    CHECK(below_flagged == 0);
+    lub_mps_free(&m);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
 int main(void)
 {
     RUN(test_couette);
@@ -335,5 +444,6 @@ int main(void)
     RUN(test_hydrostatic_3d);
     RUN(test_poiseuille_3d);
     RUN(test_step_bearing);
+    RUN(test_surface_film);
     return test_summary();
 }

@@ -27,6 +27,18 @@
  *              between writing its time folder and its table, or the table was deleted), or
  *              the one there began before timeStart (changed since), it says so and
  *              averages from its start time only.
+ *
+ *       wallLoad:     { type: wallLoad, patch: cylinder, bin: 2.5e-5, from: ..., to: ...,
+ *                       timeStart: 0.024, timeEnd: 0.030 }     # every step of the window
+ *
+ * load.dat:    # t[s] load[N/m] particles   the load of the step: the integral over
+ *              [from, to] of the wall pressure of the patch at that step, binned as
+ *              wallPressure bins it (the mean pressure of the bin's wall particles times the
+ *              bin width; a bin with no wall particle adds nothing; 3-D: the mean over z,
+ *              per unit width), and the number of wall particles counted.  One row per step
+ *              (or per `interval` steps) inside the window, appended during the run: the
+ *              per-step history of what wallPressure averages, to see whether the window
+ *              holds one steady state.
  * The cost table (postProcessing/cost/<startTime>/cost.dat) is written by lubFoam itself.
  *
  * With the elasticWall model (constant/models.yaml) a table is always written, every
@@ -49,13 +61,13 @@
 #include "io/table.h"
 #include "lubFoam.h"
 
-enum { FO_TOTALS, FO_WALLPRESSURE };
+enum { FO_TOTALS, FO_WALLPRESSURE, FO_WALLLOAD };
 
 typedef struct {
     int type;
     char name[64];
     long interval;
-    FILE *fp; /* totals: appended during the run */
+    FILE *fp; /* totals, wallLoad: appended during the run */
     /* wallPressure */
     int patch;
     double from, to, bin, t0, t1;
@@ -209,7 +221,7 @@ static void wall_pressure(fo *o, lubfoam_run *r);
 
 lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
 {
-    static const char *const types[] = {"totals", "wallPressure", NULL};
+    static const char *const types[] = {"totals", "wallPressure", "wallLoad", NULL};
     lubfoam_functions *F = lub_calloc(1, sizeof *F);
     lub_node *fs = r->ctl.functions;
     size_t n = fs ? lub_node_size(fs) : 0;
@@ -272,6 +284,12 @@ void lubfoam_functions_start(lubfoam_functions *F, lubfoam_run *r)
                                        "momentumZ[kg/s] kineticEnergy[J/m] fluidParticles"
                                      : "t[s] mass[kg] momentumX[kg*m/s] momentumY[kg*m/s] "
                                        "momentumZ[kg*m/s] kineticEnergy[J] fluidParticles");
+        } else if (o->type == FO_WALLLOAD) {
+            char path[LUB_PATH_MAX];
+            lub_postproc_path(&r->cs, o->name, r->start_name, "load.dat", path);
+            o->fp = fopen(path, "w");
+            if (!o->fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+            lub_table_write_header(o->fp, "t[s] load[N/m] particles");
         } else if (!wall_pressure_resume(o, r) && r->step > 0 && r->step % o->interval == 0) {
             /* a restart that continues no earlier average samples its start state, as the
              * run that wrote it did after that step (wall_pressure keeps to the window) */
@@ -316,9 +334,9 @@ static void totals(fo *o, lubfoam_run *r)
     fflush(o->fp);
 }
 
-static void wall_pressure(fo *o, lubfoam_run *r)
+/* Add the wall pressure of o's patch at this step to o->sum, o->count (bins in x). */
+static void wall_pressure_bin(fo *o, const lubfoam_run *r)
 {
-    if (r->t < o->t0 - 0.5 * r->dt || r->t > o->t1 + 0.5 * r->dt) return;
     const lub_particles *P = &r->P;
     for (size_t i = 0; i < P->n; i++) {
         if (P->kind[i] != LUB_WALL || P->patch[i] != o->patch) continue;
@@ -334,8 +352,38 @@ static void wall_pressure(fo *o, lubfoam_run *r)
         o->sum[b] += P->p[i];
         o->count[b]++;
     }
+}
+
+static int in_window(const fo *o, const lubfoam_run *r)
+{
+    return !(r->t < o->t0 - 0.5 * r->dt || r->t > o->t1 + 0.5 * r->dt);
+}
+
+static void wall_pressure(fo *o, lubfoam_run *r)
+{
+    if (!in_window(o, r)) return;
+    wall_pressure_bin(o, r);
     if (!o->samples++) o->tfirst = r->t;
     o->tlast = r->t;
+}
+
+static void wall_load(fo *o, lubfoam_run *r)
+{
+    if (!in_window(o, r)) return;
+    memset(o->sum, 0, (size_t)o->nbins * sizeof *o->sum);
+    memset(o->count, 0, (size_t)o->nbins * sizeof *o->count);
+    wall_pressure_bin(o, r);
+    double load = 0;
+    long np = 0;
+    for (int b = 0; b < o->nbins; b++) {
+        if (!o->count[b]) continue;
+        /* the last bin may be cut short by `to` */
+        double w = fmin(o->bin, o->to - (o->from + b * o->bin));
+        load += o->sum[b] / (double)o->count[b] * w;
+        np += o->count[b];
+    }
+    double row[3] = {r->t, load, (double)np};
+    lub_table_write_row(o->fp, row, 3);
 }
 
 void lubfoam_functions_execute(lubfoam_functions *F, lubfoam_run *r)
@@ -346,6 +394,8 @@ void lubfoam_functions_execute(lubfoam_functions *F, lubfoam_run *r)
         if (r->step % o->interval != 0) continue;
         if (o->type == FO_TOTALS)
             totals(o, r);
+        else if (o->type == FO_WALLLOAD)
+            wall_load(o, r);
         else
             wall_pressure(o, r);
     }
@@ -355,6 +405,7 @@ void lubfoam_functions_write(lubfoam_functions *F, lubfoam_run *r)
 {
     for (int k = 0; k < F->n; k++) {
         fo *o = &F->f[k];
+        if (o->type == FO_WALLLOAD) fflush(o->fp); /* rows kept in stdio's buffer between writes */
         /* nothing averaged (outside the window): no table, which would hide the earlier
          * run's average from whoever takes the latest start time's */
         if (o->type != FO_WALLPRESSURE || !o->samples) continue;

@@ -379,8 +379,9 @@ int main(int argc, char **argv)
         .usage = "[OPTIONS]",
         .description =
             "  Starts from the time folder chosen by startFrom in system/controlDict.yaml,\n"
-            "  advances to endTime (or nSteps), writes time folders and the tables of\n"
-            "  the function objects, and reports its cost in\n"
+            "  advances to endTime (to the first step at or after it: a step is never\n"
+            "  shortened, the log says where the run ends) or nSteps, writes time folders\n"
+            "  and the tables of the function objects, and reports its cost in\n"
             "  postProcessing/cost/<startTime>/cost.dat (a case already at its endTime:\n"
             "  nothing to run, nothing written).  SIGINT/SIGTERM write the\n"
             "  current state and exit 0.  A non-finite value, a particle leaving the\n"
@@ -457,6 +458,23 @@ int main(int argc, char **argv)
     else
         lubfoam_functions_start(fos, &r);
 
+    /* The last step is never shortened to land on endTime (as OpenFOAM with a fixed deltaT):
+     * the pressure of a step scales as 1/dt^2 through the source of T-9, so a short last
+     * step left a last time folder and the last samples of the function objects at several
+     * times the pressure of the others.  The run ends at the first step at or after
+     * endTime (lub_control_finished), and says so when that is not endTime itself. */
+    const int nr = r.opt ? r.opt->nr : 1;
+    if (!nothing_to_run && r.ctl.stop_at == LUB_STOP_ENDTIME && !r.ctl.adjust_time_step) {
+        const double h = nr * r.dt;
+        const double k = ceil((r.ctl.end_time - 1e-3 * r.dt - r.t) / h);
+        const double t_last = r.t + k * h;
+        if (fabs(t_last - r.ctl.end_time) > 1e-3 * r.dt)
+            lub_message("lubFoam: endTime %g is not a whole number of steps of %g s from the "
+                        "start time %s: the run ends at the first step after it, t = %.9g "
+                        "(%.0f steps; a step is never shortened to land on endTime)",
+                        r.ctl.end_time, h, r.start_name, t_last, k * nr);
+    }
+
     install_stop_handlers();
     const int tty = isatty(STDOUT_FILENO);
     const double wall0 = lub_wtime();
@@ -467,7 +485,6 @@ int main(int argc, char **argv)
 
     /* multi-resolution with sub-stepping: one pass of the loop is one step of the coarsest
      * level, nr steps of deltaT (dt below) on the finest level (nr: the product of the Nr) */
-    const int nr = r.opt ? r.opt->nr : 1;
     while (!lub_control_finished(&r.ctl, r.t, steps, r.dt)) {
         if (r.ctl.adjust_time_step && r.opt) {
             /* every level takes dt: the largest u_max / l0 of the levels limits it */
@@ -477,10 +494,6 @@ int main(int argc, char **argv)
             double dtc = r.ctl.max_courant * r.mps.l0 / r.mps.st.umax;
             r.dt = dtc < r.ctl.delta_t ? dtc : r.ctl.delta_t;
         }
-        if (nr > 1 && r.ctl.stop_at == LUB_STOP_ENDTIME && r.t + nr * r.dt > r.ctl.end_time)
-            r.dt = (r.ctl.end_time - r.t) / nr; /* land on endTime exactly */
-        else if (r.ctl.stop_at == LUB_STOP_ENDTIME && r.t + r.dt > r.ctl.end_time)
-            r.dt = r.ctl.end_time - r.t; /* land on endTime exactly */
         long bad = -1;
         char msg[1024];
         lub_step_status s = LUB_STEP_OK;
@@ -593,6 +606,11 @@ int main(int argc, char **argv)
         }
     }
     if (tty && !nothing_to_run) fputc('\n', stdout);
+    if (status == LUB_EXIT_OK && !stop_signal && r.ctl.adjust_time_step &&
+        r.ctl.stop_at == LUB_STOP_ENDTIME && r.t > r.ctl.end_time + 1e-3 * r.dt)
+        lub_message("lubFoam: the last step ended at t = %.9g, %.3g s after endTime %g (a step "
+                    "is never shortened to land on endTime)",
+                    r.t, r.t - r.ctl.end_time, r.ctl.end_time);
     if (!nothing_to_run) write_cost(&r, steps, lub_wtime() - wall0, pit_sum, vit_sum);
     if (r.has_elastic && !nothing_to_run) {
         const lub_mps_elastic *w = &r.elastic;
