@@ -405,6 +405,28 @@ int lub_geometry_find_wall(const lub_geometry *g, const char *name)
     return -1;
 }
 
+void lub_wall_translate(lub_wall *w, const lub_wall *w0, const double *d)
+{
+    double *pts = w->pts;
+    if (w0->npts > 0 && !pts) lub_bug("lub_wall_translate: no vertex array for '%s'", w0->name);
+    *w = *w0;
+    w->pts = w0->npts > 0 ? pts : NULL;
+    for (int k = 0; k < 3; k++) {
+        w->point[k] += d[k];
+        w->from[k] += d[k];
+        w->to[k] += d[k];
+        w->centre[k] += d[k];
+        w->min[k] += d[k];
+        w->max[k] += d[k];
+    }
+    for (int i = 0; i < w0->npts; i++) {
+        w->pts[2 * i] = w0->pts[2 * i] + d[0];
+        w->pts[2 * i + 1] = w0->pts[2 * i + 1] + d[1];
+    }
+    w->range[0] += d[0];
+    w->range[1] += d[0];
+}
+
 /* ---- wall functions ------------------------------------------------------------------- */
 
 /* Heights y where the line (x, y, 0) crosses the round surface of a circle (2-D), a 3-D

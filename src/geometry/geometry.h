@@ -60,10 +60,10 @@ typedef struct {
     double axis[3];             /* 3-D cylinder axis (unit) */
     double *pts;                /* polyline: npts points (x, y) */
     int npts;
-    double min[3], max[3];  /* box */
-    int fluid_inside;       /* cylinder, sphere, box */
-    int fluid_above;        /* segment, polyline */
-    int has_range;          /* cylinder arc / plane limited in x */
+    double min[3], max[3]; /* box */
+    int fluid_inside;      /* cylinder, sphere, box */
+    int fluid_above;       /* segment, polyline */
+    int has_range;         /* cylinder arc / plane limited in x */
     double range[2];
 } lub_wall;
 
@@ -72,11 +72,11 @@ typedef enum { LUB_REGION_LAYER, LUB_REGION_BOX, LUB_REGION_BETWEEN } lub_region
 typedef struct {
     lub_region_type type;
     const lub_node *node;
-    int wall;             /* layer: wall index */
-    double thickness;     /* layer */
+    int wall;              /* layer: wall index */
+    double thickness;      /* layer */
     double min[3], max[3]; /* box */
-    int lower, upper;     /* between: wall indices */
-    double height;        /* between */
+    int lower, upper;      /* between: wall indices */
+    double height;         /* between */
 } lub_region;
 
 typedef struct {
@@ -116,5 +116,13 @@ int lub_wall_height(const lub_wall *w, double x, int upper, double *y);
 
 /* Signed distance from point x to the wall surface, positive on the fluid side. */
 double lub_wall_distance(const lub_wall *w, const double *x, int dim);
+
+/* w = w0 translated by d (3 components): every point of its definition moved (a plane's
+ * point, a segment's ends, a cylinder's or sphere's centre, the vertices of a polyline, a
+ * box, the x-range of an arc or plane), its shape and fluid side kept.  w->pts is w's own
+ * array (kept, the moved vertices written into it): it must hold w0->npts points, or be
+ * NULL when w0 has none.  A rigid wall moving at velocity v is at time t the wall of t = 0
+ * translated by v t (reynoldsRef's reference at time t). */
+void lub_wall_translate(lub_wall *w, const lub_wall *w0, const double *d);
 
 #endif
