@@ -439,6 +439,112 @@ static void sample_sphere(gen_ctx *c, const lub_wall *w)
     }
 }
 
+/* A candidate point of a polygon, and its cell of side l0/2 (for the spacing check). */
+typedef struct {
+    double x[2];
+    long cx, cy;
+    int layer, keep;
+} poly_pt;
+
+static int poly_cell_cmp(const void *a, const void *b)
+{
+    const poly_pt *p = *(const poly_pt *const *)a, *q = *(const poly_pt *const *)b;
+    if (p->cx != q->cx) return p->cx < q->cx ? -1 : 1;
+    if (p->cy != q->cy) return p->cy < q->cy ? -1 : 1;
+    return (p > q) - (p < q); /* generation order */
+}
+
+/* First entry of the sorted cell index whose cell is (cx, cy) or after it. */
+static size_t poly_cell_find(poly_pt *const *idx, size_t n, long cx, long cy)
+{
+    size_t lo = 0, hi = n;
+    while (lo < hi) {
+        size_t mid = lo + (hi - lo) / 2;
+        if (idx[mid]->cx < cx || (idx[mid]->cx == cx && idx[mid]->cy < cy))
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+/* Closed polygon (2-D; counter-clockwise, solid inside, fluid outside).  Layer j = 0 (the
+ * wall particles) .. dummyLayers is the boundary moved j l0 inwards, each vertex along its
+ * mitre (the point j l0 from the lines of both its edges), so that the layers of an
+ * axis-aligned corner, convex or concave, are the lattice's rows and columns, the corner
+ * square included.  Each edge of a layer is divided into round(length / l0) equal steps
+ * from its first vertex, so the vertices are particles (corners are not cut) and no vertex
+ * is placed twice.  A dummy is kept only inside the body and at least j l0 from every edge
+ * (a layer folding over itself in a thin part or at a sharp corner is cut off; an edge the
+ * offset turns round is dropped), and a point only if no point placed before it (the wall
+ * layer first, then the dummy layers in turn) lies within 0.5 l0: no double particles at a
+ * vertex, an edge shorter than l0/2 or a body thinner than its layers. */
+static void sample_polygon(gen_ctx *c, const lub_wall *w)
+{
+    const lub_geometry *g = c->g;
+    const double l0 = g->levels[c->level].l0, h = 0.5 * l0;
+    const int n = w->npts, L = g->dummy_layers;
+    const double *v = w->pts;
+    double *t = lub_malloc(2 * (size_t)n * sizeof *t),
+           *mit = lub_malloc(2 * (size_t)n * sizeof *mit);
+    for (int i = 0; i < n; i++) { /* unit tangents of the edges i -> i + 1 */
+        int k = (i + 1) % n;
+        double tx = v[2 * k] - v[2 * i], ty = v[2 * k + 1] - v[2 * i + 1], len = hypot(tx, ty);
+        t[2 * i] = tx / len, t[2 * i + 1] = ty / len;
+    }
+    for (int i = 0; i < n; i++) { /* mitre of vertex i: m . n_a = m . n_b = 1 */
+        int a = (i + n - 1) % n;
+        double nax = -t[2 * a + 1], nay = t[2 * a], nbx = -t[2 * i + 1], nby = t[2 * i];
+        double den = 1.0 + nax * nbx + nay * nby; /* > 0: no edge folds back (read_polygon) */
+        mit[2 * i] = (nax + nbx) / den, mit[2 * i + 1] = (nay + nby) / den;
+    }
+    poly_pt *q = NULL;
+    size_t nq = 0, cap = 0;
+    for (int j = 0; j <= L; j++)
+        for (int i = 0; i < n; i++) {
+            int k = (i + 1) % n;
+            double a[2] = {v[2 * i] + j * l0 * mit[2 * i], v[2 * i + 1] + j * l0 * mit[2 * i + 1]};
+            double b[2] = {v[2 * k] + j * l0 * mit[2 * k], v[2 * k + 1] + j * l0 * mit[2 * k + 1]};
+            double ex = b[0] - a[0], ey = b[1] - a[1];
+            if (ex * t[2 * i] + ey * t[2 * i + 1] <= 0.0) continue; /* turned round */
+            long steps = lround(hypot(ex, ey) / l0);
+            if (steps < 1) steps = 1;
+            for (long m = 0; m < steps; m++) {
+                double s = (double)m / (double)steps, x[3] = {a[0] + s * ex, a[1] + s * ey, 0};
+                if (j > 0 && !(lub_wall_distance(w, x, 2) <= -(j * l0 - 1e-6 * l0))) continue;
+                if (nq == cap) {
+                    cap = cap ? 2 * cap : 256;
+                    q = lub_realloc(q, cap * sizeof *q);
+                }
+                q[nq++] =
+                    (poly_pt){{x[0], x[1]}, (long)floor(x[0] / h), (long)floor(x[1] / h), j, 1};
+            }
+        }
+    /* the spacing check, in generation order, on an index sorted by cell */
+    poly_pt **idx = lub_malloc((nq ? nq : 1) * sizeof *idx);
+    for (size_t i = 0; i < nq; i++) idx[i] = &q[i];
+    qsort(idx, nq, sizeof *idx, poly_cell_cmp);
+    for (size_t i = 0; i < nq; i++) {
+        poly_pt *p = &q[i];
+        for (long cx = p->cx - 1; cx <= p->cx + 1 && p->keep; cx++)
+            for (long cy = p->cy - 1; cy <= p->cy + 1 && p->keep; cy++)
+                for (size_t r = poly_cell_find(idx, nq, cx, cy);
+                     r < nq && idx[r]->cx == cx && idx[r]->cy == cy && idx[r] < p; r++)
+                    if (idx[r]->keep &&
+                        hypot(idx[r]->x[0] - p->x[0], idx[r]->x[1] - p->x[1]) < h * (1 - 1e-9)) {
+                        p->keep = 0;
+                        break;
+                    }
+    }
+    for (size_t i = 0; i < nq; i++)
+        if (q[i].keep)
+            push(c, (double[]){q[i].x[0], q[i].x[1], 0}, q[i].layer ? LUB_DUMMY : LUB_WALL);
+    free(idx);
+    free(q);
+    free(t);
+    free(mit);
+}
+
 static void discretise_wall(gen_ctx *c, const lub_wall *w)
 {
     const lub_geometry *g = c->g;
@@ -482,6 +588,9 @@ static void discretise_wall(gen_ctx *c, const lub_wall *w)
         break;
     case LUB_WALL_SPHERE:
         sample_sphere(c, w);
+        break;
+    case LUB_WALL_POLYGON:
+        sample_polygon(c, w);
         break;
     }
 }
@@ -721,6 +830,13 @@ double lub_geometry_estimate(const lub_geometry *g)
             break;
         case LUB_WALL_SEGMENT:
             total += layers * hypot(w->to[0] - w->from[0], w->to[1] - w->from[1]) / l0;
+            break;
+        case LUB_WALL_POLYGON:
+            for (int j = 0; j < w->npts; j++)
+                total += layers *
+                         hypot(w->pts[2 * ((j + 1) % w->npts)] - w->pts[2 * j],
+                               w->pts[2 * ((j + 1) % w->npts) + 1] - w->pts[2 * j + 1]) /
+                         l0;
             break;
         case LUB_WALL_POLYLINE:
             for (int j = 0; j + 1 < w->npts; j++)

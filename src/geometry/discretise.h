@@ -9,7 +9,10 @@
  * discretised on the lattice itself (their faces must lie on it), so corners of tanks are
  * filled without gaps or duplicates; inclined planes, segments, polylines, cylinders and
  * spheres are sampled along their surface at arc-length spacing l0, with the dummy layers as
- * offset surfaces k l0 behind (concentric arcs R -/+ k l0 on cylinders and spheres).
+ * offset surfaces k l0 behind (concentric arcs R -/+ k l0 on cylinders and spheres).  A
+ * polygon (a closed body) has a wall particle at every corner and round(length / l0) equal
+ * steps along each edge; its dummy layers are the boundary moved k l0 inwards, each corner
+ * along its mitre (discretise.c, sample_polygon).
  *
  * Ownership.  A point (wall, dummy or fluid) belongs to the level that owns its x (the first
  * level whose region contains x, else the last level).

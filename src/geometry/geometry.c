@@ -10,7 +10,7 @@
 #include "core/error.h"
 
 static const char *const wall_types[] = {"plane", "segment", "cylinder", "polyline",
-                                         "box",   "sphere",  NULL};
+                                         "box",   "sphere",  "polygon",  NULL};
 static const char *const region_types[] = {"layer", "box", "between", NULL};
 static const char *const axis_names[] = {"x", "y", "z", NULL};
 
@@ -114,6 +114,95 @@ static void read_polyline(lub_wall *w, lub_node *m)
     }
 }
 
+/* Whether the closed segments p-q and r-s have a point in common. */
+static int segments_meet(const double *p, const double *q, const double *r, const double *s)
+{
+    double d1 = (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
+    double d2 = (q[0] - p[0]) * (s[1] - p[1]) - (q[1] - p[1]) * (s[0] - p[0]);
+    double d3 = (s[0] - r[0]) * (p[1] - r[1]) - (s[1] - r[1]) * (p[0] - r[0]);
+    double d4 = (s[0] - r[0]) * (q[1] - r[1]) - (s[1] - r[1]) * (q[0] - r[0]);
+    if (((d1 > 0 && d2 < 0) || (d1 < 0 && d2 > 0)) && ((d3 > 0 && d4 < 0) || (d3 < 0 && d4 > 0)))
+        return 1;
+    /* collinear or touching: an end of one segment on the other */
+    const double *a[4] = {r, s, p, q}, *b0[4] = {p, p, r, r}, *b1[4] = {q, q, s, s};
+    const double d[4] = {d1, d2, d3, d4};
+    for (int k = 0; k < 4; k++)
+        if (d[k] == 0.0 && a[k][0] >= fmin(b0[k][0], b1[k][0]) &&
+            a[k][0] <= fmax(b0[k][0], b1[k][0]) && a[k][1] >= fmin(b0[k][1], b1[k][1]) &&
+            a[k][1] <= fmax(b0[k][1], b1[k][1]))
+            return 1;
+    return 0;
+}
+
+/* A closed polygon: vertices in any order around it and either orientation, stored
+ * counter-clockwise (the solid on the left of every edge); the first vertex repeated at the
+ * end is dropped.  Refused: fewer than 3 vertices, a zero-length edge, zero area, adjacent
+ * edges folding back onto each other, edges that cross or touch (the boundary must be a
+ * simple closed curve). */
+static void read_polygon(lub_wall *w, lub_node *m)
+{
+    lub_node *pts = lub_dict_seq(m, "points");
+    size_t n = lub_node_size(pts);
+    w->pts = lub_malloc(2 * (n ? n : 1) * sizeof *w->pts);
+    for (size_t i = 0; i < n; i++) {
+        lub_node *p = lub_node_item(pts, i);
+        if (lub_node_type_of(p) != LUB_NODE_SEQUENCE || lub_node_size(p) != 2)
+            lub_node_error(p, "polygon '%s': point %zu must be [x, y]", w->name, i);
+        w->pts[2 * i] = lub_node_real(lub_node_item(p, 0), LUB_ANY);
+        w->pts[2 * i + 1] = lub_node_real(lub_node_item(p, 1), LUB_ANY);
+    }
+    if (n > 1 && w->pts[0] == w->pts[2 * n - 2] && w->pts[1] == w->pts[2 * n - 1]) n--;
+    if (n < 3)
+        lub_node_error(pts, "polygon '%s' needs at least 3 different points, found %zu", w->name,
+                       n);
+    w->npts = (int)n;
+    double *v = w->pts, area2 = 0.0, ext = 0.0;
+    for (size_t i = 0; i < n; i++) {
+        size_t j = (i + 1) % n;
+        area2 += v[2 * i] * v[2 * j + 1] - v[2 * j] * v[2 * i + 1];
+        ext = fmax(ext, fmax(fabs(v[2 * i]), fabs(v[2 * i + 1])));
+        if (v[2 * i] == v[2 * j] && v[2 * i + 1] == v[2 * j + 1])
+            lub_node_error(lub_node_item(pts, j), "polygon '%s': point %zu repeats point %zu",
+                           w->name, j, i);
+    }
+    for (size_t i = 0; i < n; i++) {
+        size_t h = (i + n - 1) % n, j = (i + 1) % n;
+        double ax = v[2 * i] - v[2 * h], ay = v[2 * i + 1] - v[2 * h + 1];
+        double bx = v[2 * j] - v[2 * i], by = v[2 * j + 1] - v[2 * i + 1];
+        double cr = ax * by - ay * bx, dt = ax * bx + ay * by;
+        if (fabs(cr) <= 1e-12 * hypot(ax, ay) * hypot(bx, by) && dt < 0)
+            lub_node_error(lub_node_item(pts, i),
+                           "polygon '%s': the edges at point %zu fold back onto each other",
+                           w->name, i);
+    }
+    for (size_t i = 0; i < n; i++) /* edges that are not neighbours must not meet */
+        for (size_t k = i + 1; k < n; k++) {
+            size_t j = (i + 1) % n, l = (k + 1) % n;
+            if (k == j || l == i) continue; /* neighbours share a vertex */
+            if (segments_meet(v + 2 * i, v + 2 * j, v + 2 * k, v + 2 * l))
+                lub_node_error(pts,
+                               "polygon '%s': its edges %zu-%zu and %zu-%zu cross or touch; the "
+                               "points must go once around the body",
+                               w->name, i, j, k, l);
+        }
+    if (!(fabs(area2) > 1e-24 * ext * ext))
+        lub_node_error(pts, "polygon '%s' encloses no area", w->name);
+    if (area2 < 0) /* clockwise: reverse */
+        for (size_t i = 0; i < n / 2; i++)
+            for (int d = 0; d < 2; d++) {
+                double t = v[2 * i + d];
+                v[2 * i + d] = v[2 * (n - 1 - i) + d];
+                v[2 * (n - 1 - i) + d] = t;
+            }
+    for (int d = 0; d < 2; d++) {
+        w->min[d] = INFINITY, w->max[d] = -INFINITY;
+        for (size_t i = 0; i < n; i++) {
+            w->min[d] = fmin(w->min[d], v[2 * i + d]);
+            w->max[d] = fmax(w->max[d], v[2 * i + d]);
+        }
+    }
+}
+
 static void read_wall(lub_geometry *g, lub_wall *w, const char *name, lub_node *m)
 {
     int dim = g->dim;
@@ -178,6 +267,10 @@ static void read_wall(lub_geometry *g, lub_wall *w, const char *name, lub_node *
         w->radius = lub_dict_real(m, "radius", LUB_POSITIVE);
         w->fluid_inside =
             lub_dict_choice(m, "fluid", (const char *const[]){"outside", "inside", NULL}, 0);
+        break;
+    case LUB_WALL_POLYGON:
+        if (dim != 2) lub_node_error(tn, "wall '%s': type 'polygon' is 2-D only", name);
+        read_polygon(w, m);
         break;
     }
 }
@@ -405,6 +498,28 @@ int lub_geometry_find_wall(const lub_geometry *g, const char *name)
     return -1;
 }
 
+void lub_wall_translate(lub_wall *w, const lub_wall *w0, const double *d)
+{
+    double *pts = w->pts;
+    if (w0->npts > 0 && !pts) lub_bug("lub_wall_translate: no vertex array for '%s'", w0->name);
+    *w = *w0;
+    w->pts = w0->npts > 0 ? pts : NULL;
+    for (int k = 0; k < 3; k++) {
+        w->point[k] += d[k];
+        w->from[k] += d[k];
+        w->to[k] += d[k];
+        w->centre[k] += d[k];
+        w->min[k] += d[k];
+        w->max[k] += d[k];
+    }
+    for (int i = 0; i < w0->npts; i++) {
+        w->pts[2 * i] = w0->pts[2 * i] + d[0];
+        w->pts[2 * i + 1] = w0->pts[2 * i + 1] + d[1];
+    }
+    w->range[0] += d[0];
+    w->range[1] += d[0];
+}
+
 /* ---- wall functions ------------------------------------------------------------------- */
 
 /* Heights y where the line (x, y, 0) crosses the round surface of a circle (2-D), a 3-D
@@ -477,6 +592,24 @@ int lub_wall_height(const lub_wall *w, double x, int upper, double *y)
         if (w->max[2] != w->min[2] && (0.0 < w->min[2] || 0.0 > w->max[2])) return 0;
         *y = (upper != 0) == !w->fluid_inside ? w->min[1] : w->max[1];
         return 1;
+    case LUB_WALL_POLYGON: {
+        /* where the vertical line at x meets the boundary (both ends of a vertical edge on
+         * it): the lowest point for the upper wall of a gap, the highest for the lower */
+        int found = 0;
+        double lo = INFINITY, hi = -INFINITY;
+        for (int i = 0; i < w->npts; i++) {
+            const double *a = w->pts + 2 * i, *b = w->pts + 2 * ((i + 1) % w->npts);
+            if (x < fmin(a[0], b[0]) || x > fmax(a[0], b[0])) continue;
+            double ya = a[1], yb = b[1];
+            if (a[0] != b[0]) ya = yb = a[1] + (b[1] - a[1]) * (x - a[0]) / (b[0] - a[0]);
+            lo = fmin(lo, fmin(ya, yb));
+            hi = fmax(hi, fmax(ya, yb));
+            found = 1;
+        }
+        if (!found) return 0;
+        *y = upper ? lo : hi;
+        return 1;
+    }
     }
     return 0;
 }
@@ -514,6 +647,22 @@ static double curve_distance(const double *pts, int n, int above, const double *
     }
     double s = side >= 0 ? 1.0 : -1.0;
     return (above ? s : -s) * best;
+}
+
+/* Signed distance to a closed polygon, positive outside: to the nearest edge, the side by
+ * the crossing number of a ray from x towards +x. */
+static double polygon_distance(const double *v, int n, const double *x)
+{
+    double best = INFINITY;
+    int inside = 0;
+    for (int i = 0; i < n; i++) {
+        const double *a = v + 2 * i, *b = v + 2 * ((i + 1) % n);
+        best = fmin(best, seg_dist(x[0], x[1], a[0], a[1], b[0], b[1]));
+        if ((a[1] > x[1]) != (b[1] > x[1]) &&
+            x[0] < a[0] + (x[1] - a[1]) * (b[0] - a[0]) / (b[1] - a[1]))
+            inside = !inside;
+    }
+    return inside ? -best : best;
 }
 
 double lub_wall_distance(const lub_wall *w, const double *x, int dim)
@@ -554,6 +703,8 @@ double lub_wall_distance(const lub_wall *w, const double *x, int dim)
         double sd = out > 0 ? sqrt(out) : -in;
         return w->fluid_inside ? -sd : sd;
     }
+    case LUB_WALL_POLYGON:
+        return polygon_distance(w->pts, w->npts, p);
     }
     return 0.0;
 }

@@ -21,6 +21,7 @@
  *                    range: [-0.0045, 0.0045] }   # x-extent of the arc (optional)
  *       ramp:      { type: segment, from: [0, 0], to: [1, 0.1], fluid: above }
  *       profile:   { type: polyline, points: [[0, 0], [1, 0.2], [2, 0]], fluid: above }
+ *       pad:       { type: polygon, points: [[0, 1], [2, 0.9], [2, 1.5], [0, 1.5]] }
  *       tank:      { type: box, min: [0, 0], max: [1.61, 0.8], fluid: inside }
  *       ball:      { type: sphere, centre: [0, 0, 1], radius: 0.1 }             # 3-D
  *       shaft:     { type: cylinder, centre: [0, 0, 1], axis: [0, 0, 1], radius: 0.1 } # 3-D
@@ -32,6 +33,9 @@
  * cylinder: `centre` or `lowestPoint`; fluid `outside` (default) or `inside`.
  * box, sphere: fluid `inside` or `outside` (box default inside: a tank; sphere outside).
  * segment, polyline (2-D): fluid `above` (default) or `below`; polyline x must increase.
+ * polygon (2-D): a closed solid body (fluid outside): at least 3 vertices in any order
+ * around it, either orientation (stored counter-clockwise), a repeated first vertex at the
+ * end dropped; the boundary must not cross or touch itself.
  * `between ... height` fills from the lower wall up to `height` above the lower wall's
  * surface, and not inside or beyond the upper wall.
  */
@@ -47,7 +51,8 @@ typedef enum {
     LUB_WALL_CYLINDER,
     LUB_WALL_POLYLINE,
     LUB_WALL_BOX,
-    LUB_WALL_SPHERE
+    LUB_WALL_SPHERE,
+    LUB_WALL_POLYGON
 } lub_wall_type;
 
 typedef struct {
@@ -58,12 +63,12 @@ typedef struct {
     double from[3], to[3];      /* segment */
     double centre[3], radius;   /* cylinder (2-D circle; 3-D with axis), sphere */
     double axis[3];             /* 3-D cylinder axis (unit) */
-    double *pts;                /* polyline: npts points (x, y) */
+    double *pts;                /* polyline, polygon (counter-clockwise): npts points (x, y) */
     int npts;
-    double min[3], max[3];  /* box */
-    int fluid_inside;       /* cylinder, sphere, box */
-    int fluid_above;        /* segment, polyline */
-    int has_range;          /* cylinder arc / plane limited in x */
+    double min[3], max[3]; /* box; polygon: its bounding box */
+    int fluid_inside;      /* cylinder, sphere, box */
+    int fluid_above;       /* segment, polyline */
+    int has_range;         /* cylinder arc / plane limited in x */
     double range[2];
 } lub_wall;
 
@@ -72,11 +77,11 @@ typedef enum { LUB_REGION_LAYER, LUB_REGION_BOX, LUB_REGION_BETWEEN } lub_region
 typedef struct {
     lub_region_type type;
     const lub_node *node;
-    int wall;             /* layer: wall index */
-    double thickness;     /* layer */
+    int wall;              /* layer: wall index */
+    double thickness;      /* layer */
     double min[3], max[3]; /* box */
-    int lower, upper;     /* between: wall indices */
-    double height;        /* between */
+    int lower, upper;      /* between: wall indices */
+    double height;         /* between */
 } lub_region;
 
 typedef struct {
@@ -111,10 +116,19 @@ int lub_geometry_find_wall(const lub_geometry *g, const char *name);
 
 /* Height of a wall's surface at x (2-D, or the z = 0 section in 3-D) as seen from the gap:
  * for the upper wall of a gap (upper != 0) the lowest point of its surface at x, for the
- * lower wall the highest.  Returns 1 and sets *y, or 0 when the wall does not span x. */
+ * lower wall the highest (a polygon over a film: its lower surface, a vertical face at x
+ * included).  Returns 1 and sets *y, or 0 when the wall does not span x. */
 int lub_wall_height(const lub_wall *w, double x, int upper, double *y);
 
 /* Signed distance from point x to the wall surface, positive on the fluid side. */
 double lub_wall_distance(const lub_wall *w, const double *x, int dim);
+
+/* w = w0 translated by d (3 components): every point of its definition moved (a plane's
+ * point, a segment's ends, a cylinder's or sphere's centre, the vertices of a polyline, a
+ * box, the x-range of an arc or plane), its shape and fluid side kept.  w->pts is w's own
+ * array (kept, the moved vertices written into it): it must hold w0->npts points, or be
+ * NULL when w0 has none.  A rigid wall moving at velocity v is at time t the wall of t = 0
+ * translated by v t (reynoldsRef's reference at time t). */
+void lub_wall_translate(lub_wall *w, const lub_wall *w0, const double *d);
 
 #endif

@@ -38,9 +38,9 @@ static _Noreturn void not_a_wall(const lub_node *node, const lub_geometry *g, co
 
 static const char *wall_type_name(lub_wall_type t)
 {
-    static const char *const names[] = {"plane",    "segment", "cylinder",
-                                        "polyline", "box",     "sphere"};
-    return (int)t >= 0 && (int)t < 6 ? names[t] : "wall";
+    static const char *const names[] = {"plane", "segment", "cylinder", "polyline",
+                                        "box",   "sphere",  "polygon"};
+    return (int)t >= 0 && (int)t < 7 ? names[t] : "wall";
 }
 
 /* h0^0 from the geometry: the lowest point of the cylinder above the highest surface of the

@@ -231,6 +231,58 @@ size_t lub_sample_bins(lub_accum *a, const lub_bins *b, const lub_particles *P, 
     return added;
 }
 
+/* A wall or dummy particle of the patch, by x. */
+typedef struct {
+    double x;
+    size_t i;
+} x_index;
+
+static int x_index_cmp(const void *a, const void *b)
+{
+    const x_index *p = a, *q = b;
+    if (p->x != q->x) return p->x < q->x ? -1 : 1;
+    return (p->i > q->i) - (p->i < q->i);
+}
+
+/* Add j to the centroid sum c of i's dummy neighbours: j a dummy of i's level within r. */
+static void facing_add(const lub_particles *P, size_t i, size_t j, double r, double *c, int *nd)
+{
+    if (P->kind[j] != LUB_DUMMY || P->level[j] != P->level[i]) return;
+    double v[3] = {0, 0, 0}, d2 = 0;
+    for (int d = 0; d < P->dim; d++) {
+        v[d] = P->x[d][i] - P->x[d][j];
+        d2 += v[d] * v[d];
+    }
+    if (d2 > r * r) return;
+    for (int d = 0; d < 3; d++) c[d] += v[d];
+    (*nd)++;
+}
+
+size_t lub_wall_facing(const lub_particles *P, int patch, int dir, unsigned char *on)
+{
+    size_t n = 0, marked = 0;
+    x_index *s = lub_malloc((P->n ? P->n : 1) * sizeof *s);
+    for (size_t i = 0; i < P->n; i++) {
+        on[i] = 0;
+        if (P->kind[i] != LUB_FLUID && P->patch[i] == patch) s[n++] = (x_index){P->x[0][i], i};
+    }
+    qsort(s, n, sizeof *s, x_index_cmp);
+    for (size_t k = 0; k < n; k++) {
+        size_t i = s[k].i;
+        if (P->kind[i] != LUB_WALL) continue;
+        const double r = 1.5 * P->levels[P->level[i]].l0;
+        double c[3] = {0, 0, 0}; /* sum of (x_i - x_dummy): along the outward normal */
+        int nd = 0;
+        for (size_t q = k; q-- > 0 && s[k].x - s[q].x <= r;) facing_add(P, i, s[q].i, r, c, &nd);
+        for (size_t q = k + 1; q < n && s[q].x - s[k].x <= r; q++)
+            facing_add(P, i, s[q].i, r, c, &nd);
+        double len = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+        if (nd && len > 0 && (dir < 0 ? -c[1] : c[1]) > 0.5 * len) on[i] = 1, marked++;
+    }
+    free(s);
+    return marked;
+}
+
 static double dist2(const lub_particles *P, size_t i, const double *xq)
 {
     double r2 = 0.0;
@@ -328,10 +380,13 @@ int lub_wall_arc(const lub_wall *w, int dim, const double *x, double *s)
         *s = along(x, w->from, tx / len, ty / len);
         return 0;
     }
-    case LUB_WALL_POLYLINE: {
+    case LUB_WALL_POLYLINE:
+    case LUB_WALL_POLYGON: {
+        /* a polygon: the closed boundary from its first vertex, counter-clockwise */
+        int closed = w->type == LUB_WALL_POLYGON, nedges = closed ? w->npts : w->npts - 1;
         double start = 0.0, best = INFINITY;
-        for (int k = 0; k + 1 < w->npts; k++) {
-            const double *a = w->pts + 2 * k, *b = a + 2;
+        for (int k = 0; k < nedges; k++) {
+            const double *a = w->pts + 2 * k, *b = w->pts + 2 * ((k + 1) % w->npts);
             double tx = b[0] - a[0], ty = b[1] - a[1], len = hypot(tx, ty);
             if (len > 0.0) {
                 double q = along(x, a, tx / len, ty / len);

@@ -116,6 +116,16 @@ double lub_bins_upper(const lub_bins *b, int k);
 size_t lub_sample_bins(lub_accum *a, const lub_bins *b, const lub_particles *P, int kind, int patch,
                        const double *coord, const double *const *vals);
 
+/* The wall particles of `patch` whose surface faces down (dir < 0) or up (dir > 0): on[i] = 1
+ * when the outward normal at i, from the centroid of the patch's dummy particles of i's level
+ * within 1.5 l0 to i (the dummy layers lie behind the surface), is within 60 degrees of -y
+ * (+y), else 0 (every other particle 0).  A closed body (a polygon, a whole circle) has wall
+ * particles on all its faces: facing down are those of its lower face, the one a film under
+ * it wets, and the bottom corners; the faces steeper than 60 degrees and the top are left out,
+ * so that wall pressure binned in x takes each x once.  Works on the particles, so a moving or
+ * deforming wall is followed.  Returns the number of particles marked. */
+size_t lub_wall_facing(const lub_particles *P, int patch, int dir, unsigned char *on);
+
 /* Kernel-weighted (Shepard) mean at point xq over the fluid and wall particles (not the
  * dummies) within the effective radius re of the level of the particle nearest to xq:
  *
@@ -144,7 +154,9 @@ void lub_totals_compute(lub_totals *t, const lub_particles *P, double rho);
  *   plane     s = (x - point) . t, t the unit tangent with t_x > 0 (t_y > 0 if vertical);
  *   segment   s = (x - from) . t, t the unit vector from `from` to `to`;
  *   polyline  s = the length along the polyline from its first point to the projection of x
- *             on the nearest piece.
+ *             on the nearest piece;
+ *   polygon   the same along the closed boundary from its first vertex, counter-clockwise
+ *             (geometry.h: the vertices as stored).
  * Returns 0, or -1 for other walls (box, sphere) and in 3-D. */
 int lub_wall_arc(const lub_wall *w, int dim, const double *x, double *s);
 

@@ -48,6 +48,7 @@ static void settings_read(lub_refcase_settings *s, const char *path)
                            lub_reynolds_bc_names[s->bc]);
     }
     s->time = lub_dict_real_or(root, "time", 0.0, LUB_NONNEGATIVE);
+    s->time_node = lub_dict_find(root, "time");
     s->tolerance = lub_dict_real_or(root, "tolerance", 1e-12, (lub_range){0.0, 1e-3, 1, 0});
     s->max_iterations = lub_dict_int_or(root, "maxIterations", 0, 0, 1000000000);
     s->bc_node = lub_dict_find(root, "boundaryCondition");
@@ -93,8 +94,12 @@ void lub_refcase_read(lub_refcase *rc, const lub_case *c)
     if (rc->wl == rc->wu)
         lub_node_error(s->upper_node, "'upperWall' and 'lowerWall' are the same wall '%s'",
                        s->upper);
-    rc->lower = &rc->g.walls[rc->wl];
-    rc->upper = &rc->g.walls[rc->wu];
+    for (int k = 0; k < 2; k++) {
+        const lub_wall *w0 = &rc->g.walls[k ? rc->wu : rc->wl];
+        rc->wt[k].pts = w0->npts ? lub_malloc(2 * (size_t)w0->npts * sizeof *w0->pts) : NULL;
+    }
+    rc->lower = &rc->wt[0];
+    rc->upper = &rc->wt[1];
 
     lub_transport_read(lub_case_path(c, path, "constant/transportProperties.yaml"), &rc->rho,
                        &rc->nu);
@@ -105,6 +110,7 @@ void lub_refcase_read(lub_refcase *rc, const lub_case *c)
     rc->vel = lub_malloc((size_t)rc->g.nwalls * sizeof *rc->vel);
     rc->moving = lub_malloc((size_t)rc->g.nwalls * sizeof *rc->moving);
     lub_moving_walls_read(lub_dict_root(md), &rc->g, rc->vel, rc->moving);
+    lub_refcase_move(rc, 0.0, NULL);
     int elastic = lub_elastic_wall_read(lub_dict_root(md), &rc->g, &rc->ew);
     lub_dict_finish(md);
     rc->u1 = rc->vel[rc->wl][0];
@@ -147,8 +153,26 @@ void lub_refcase_read(lub_refcase *rc, const lub_case *c)
     rc->ew.node = rc->ew.patch_node = rc->ew.ramp_node = NULL; /* freed with md */
 }
 
+/* Wall w0 moving at v, translated to time t into w (w->pts its own array). */
+static void wall_at(lub_wall *w, const lub_wall *w0, const double *v, double t)
+{
+    double d[3] = {v[0] * t, v[1] * t, v[2] * t};
+    lub_wall_translate(w, w0, d);
+}
+
+void lub_refcase_move(lub_refcase *rc, double t, const lub_node *node)
+{
+    if (!(t >= 0.0) || !isfinite(t)) lub_bug("lub_refcase_move: t = %g", t);
+    wall_at(&rc->wt[0], &rc->g.walls[rc->wl], rc->vel[rc->wl], t);
+    wall_at(&rc->wt[1], &rc->g.walls[rc->wu], rc->vel[rc->wu], t);
+    rc->t = t;
+    rc->t_node = node;
+}
+
 void lub_refcase_free(lub_refcase *rc)
 {
+    free(rc->wt[0].pts);
+    free(rc->wt[1].pts);
     free(rc->vel);
     free(rc->moving);
     lub_dict_free(rc->s.dict);
@@ -156,24 +180,96 @@ void lub_refcase_free(lub_refcase *rc)
     memset(rc, 0, sizeof *rc);
 }
 
-/* Height of wall w at x, fatal (at the inlet or outlet entry) when the wall does not span x. */
-static double wall_y(const lub_refcase_settings *s, const lub_wall *w, double x, int upper)
+/* " at t = 0.002 s (moved by (u t, v t) m)" when the walls are those of a time t > 0 at
+ * which wall w has moved, else "". */
+static const char *moved_note(const lub_refcase *rc, const lub_wall *w, char *buf, size_t size)
 {
+    const double *v = rc->vel[w == rc->lower ? rc->wl : rc->wu];
+    buf[0] = '\0';
+    if (rc->t > 0.0 && (v[0] != 0.0 || v[1] != 0.0 || v[2] != 0.0))
+        snprintf(buf, size, " at t = %g s (moved by (%g, %g) m from system/particleGenDict.yaml)",
+                 rc->t, v[0] * rc->t, v[1] * rc->t);
+    return buf;
+}
+
+/* Height of wall w (rc->lower or rc->upper) at x, fatal (at the inlet or outlet entry) when
+ * the wall does not span x. */
+static double wall_y(const lub_refcase *rc, const lub_wall *w, double x, int upper)
+{
+    const lub_refcase_settings *s = &rc->s;
     double y;
+    char note[160];
     if (!lub_wall_height(w, x, upper, &y))
         lub_node_error(x < 0.5 * (s->inlet + s->outlet) ? s->inlet_node : s->outlet_node,
-                       "the %s wall '%s' does not span [inlet, outlet] = [%g, %g]: no surface "
-                       "at x = %.9g",
-                       upper ? "upper" : "lower", w->name, s->inlet, s->outlet, x);
+                       "the %s wall '%s'%s does not span [inlet, outlet] = [%g, %g]: no "
+                       "surface at x = %.9g",
+                       upper ? "upper" : "lower", w->name, moved_note(rc, w, note, sizeof note),
+                       s->inlet, s->outlet, x);
     return y;
 }
 
 /* Slope dy/dx of a wall surface at x, by central differences inside [xa, xb]. */
-static double wall_slope(const lub_refcase_settings *s, const lub_wall *w, double x, int upper,
-                         double dx)
+static double wall_slope(const lub_refcase *rc, const lub_wall *w, double x, int upper, double dx)
 {
+    const lub_refcase_settings *s = &rc->s;
     double d = 1e-3 * dx, xl = fmax(x - d, s->inlet), xr = fmin(x + d, s->outlet);
-    return (wall_y(s, w, xr, upper) - wall_y(s, w, xl, upper)) / (xr - xl);
+    return (wall_y(rc, w, xr, upper) - wall_y(rc, w, xl, upper)) / (xr - xl);
+}
+
+/* The smallest gap on the 2n + 1 sample points of [inlet, outlet] with both walls moved to
+ * time t, or NAN when a wall does not span a point. */
+static double min_gap_at(const lub_refcase *rc, double t, int n)
+{
+    const lub_refcase_settings *s = &rc->s;
+    lub_wall w[2];
+    double m = INFINITY;
+    for (int k = 0; k < 2; k++) {
+        const lub_wall *w0 = &rc->g.walls[k ? rc->wu : rc->wl];
+        w[k].pts = w0->npts ? lub_malloc(2 * (size_t)w0->npts * sizeof *w0->pts) : NULL;
+        wall_at(&w[k], w0, rc->vel[k ? rc->wu : rc->wl], t);
+    }
+    for (int i = 0; i <= 2 * n && !isnan(m); i++) {
+        double x = s->inlet + 0.5 * i * (s->outlet - s->inlet) / n, yl, yu;
+        if (!lub_wall_height(&w[0], x, 0, &yl) || !lub_wall_height(&w[1], x, 1, &yu))
+            m = NAN;
+        else
+            m = fmin(m, yu - yl);
+    }
+    free(w[0].pts);
+    free(w[1].pts);
+    return m;
+}
+
+/* Fatal: the gap at x is <= 0 at time rc->t.  When it was open at t = 0, the walls have
+ * moved into each other: the message gives the time at which they touch (bisection on the
+ * smallest sampled gap) and names the time's entry. */
+_Noreturn static void gap_closed(const lub_refcase *rc, double x, double gap)
+{
+    const lub_refcase_settings *s = &rc->s;
+    const char *what = gap == 0.0 ? "zero" : "negative";
+    double g0 = rc->t > 0.0 ? min_gap_at(rc, 0.0, (int)s->cells) : NAN;
+    if (!(g0 > 0.0))
+        lub_node_error(s->upper_node,
+                       "the gap between '%s' and '%s' is %s at x = %.9g: it must be > 0 on "
+                       "[inlet, outlet] = [%g, %g]",
+                       s->lower, s->upper, what, x, s->inlet, s->outlet);
+    double ta = 0.0, tb = rc->t;
+    for (int it = 0; it < 200 && tb - ta > 1e-12 * rc->t; it++) {
+        double tm = 0.5 * (ta + tb), gm = min_gap_at(rc, tm, (int)s->cells);
+        if (gm > 0.0)
+            ta = tm;
+        else
+            tb = tm;
+    }
+    const double *vl = rc->vel[rc->wl], *vu = rc->vel[rc->wu];
+    char msg[1024];
+    snprintf(msg, sizeof msg,
+             "at t = %g s the gap between '%s' and '%s' is %s at x = %.9g m: the walls, moving "
+             "at (%g, %g) and (%g, %g) m/s (constant/models.yaml movingWalls), close the gap "
+             "(%.6g m at t = 0) at t = %.6g s; a reference needs t below that",
+             rc->t, s->lower, s->upper, what, x, vl[0], vl[1], vu[0], vu[1], g0, tb);
+    if (rc->t_node) lub_node_error(rc->t_node, "%s", msg);
+    lub_fatal("%s", msg);
 }
 
 /* h(x) = (upper wall height) - (lower wall height) at nodes and faces. */
@@ -192,14 +288,10 @@ static void gap_heights(lub_refgap *G, const lub_refcase *rc)
     int i_h0 = 0;
     for (int i = 0; i <= 2 * n; i++) {
         double x = i == 2 * n ? G->xb : G->xa + 0.5 * i * dx;
-        double gap = wall_y(s, rc->upper, x, 1) - wall_y(s, rc->lower, x, 0);
+        double gap = wall_y(rc, rc->upper, x, 1) - wall_y(rc, rc->lower, x, 0);
         if (!(gap > 0.0)) {
             lub_refgap_free(G);
-            lub_node_error(s->upper_node,
-                           "the gap between '%s' and '%s' is %s at x = %.9g: it must be > 0 "
-                           "on [inlet, outlet] = [%g, %g]",
-                           s->lower, s->upper, gap == 0.0 ? "zero" : "negative", x, s->inlet,
-                           s->outlet);
+            gap_closed(rc, x, gap);
         }
         if (i % 2 == 0)
             G->h[i / 2] = gap;
@@ -225,17 +317,17 @@ static void gap_heights(lub_refgap *G, const lub_refcase *rc)
 }
 
 /* dh/dt at fixed x for walls translating with velocities vl (lower) and vu (upper): the
- * normal speeds, and each surface carried along x (-U dy/dx), which vanishes for walls
- * parallel to x (the squeeze term of T-32). */
+ * normal speeds, and each surface, at its place at time rc->t, carried along x (-U dy/dx),
+ * which vanishes for walls parallel to x (the squeeze term of T-32, 12 dh/dt of
+ * methods2.md (9.1); its 6 h d(U1+U2)/dx is 0 for rigid walls). */
 static void gap_motion(lub_refgap *G, const lub_refcase *rc)
 {
-    const lub_refcase_settings *s = &rc->s;
     const double *vl = rc->vel[rc->wl], *vu = rc->vel[rc->wu];
     G->moving_shape = 0;
     for (int i = 0; i <= G->n; i++) {
         double x = G->xa + i * G->dx, r = vu[1] - vl[1];
-        if (vu[0] != 0.0) r -= vu[0] * wall_slope(s, rc->upper, x, 1, G->dx);
-        if (vl[0] != 0.0) r += vl[0] * wall_slope(s, rc->lower, x, 0, G->dx);
+        if (vu[0] != 0.0) r -= vu[0] * wall_slope(rc, rc->upper, x, 1, G->dx);
+        if (vl[0] != 0.0) r += vl[0] * wall_slope(rc, rc->lower, x, 0, G->dx);
         G->dhdt[i] = r;
         G->moving_shape |= r != 0.0;
     }

@@ -46,7 +46,8 @@ typedef struct {
     long cells;
     int bc; /* lub_reynolds_bc */
     double exit_x;
-    double time;
+    double time;         /* time: (default 0) */
+    lub_node *time_node; /* time entry (or NULL) */
     double tolerance;
     long max_iterations;
     lub_node *bc_node;       /* boundaryCondition entry (or NULL) */
@@ -60,9 +61,12 @@ typedef struct {
 /* Everything the reference reads from a case. */
 typedef struct {
     lub_refcase_settings s;
-    lub_geometry g;
+    lub_geometry g;                /* the geometry as written: the walls at t = 0 */
     int wl, wu;                    /* wall indices of the lower and upper wall */
-    const lub_wall *lower, *upper; /* &g.walls[wl], &g.walls[wu] */
+    const lub_wall *lower, *upper; /* the lower and upper wall at time t (&wt[0], &wt[1]) */
+    lub_wall wt[2];                /* g.walls[wl], g.walls[wu] moved to time t */
+    double t;                      /* the time of lower and upper (lub_refcase_move) */
+    const lub_node *t_node;        /* the entry t came from, or NULL (the -time option) */
     double rho, nu, mu;            /* oil; mu = rho nu */
     double (*vel)[3];              /* velocity of every wall of g (movingWalls) */
     int *moving;                   /* 1 when the wall is listed in movingWalls */
@@ -71,9 +75,19 @@ typedef struct {
     lub_elastic_wall ew;           /* constant/models.yaml elasticWall (read when present) */
 } lub_refcase;
 
-/* Read the four dictionaries strictly (fatal with file:line on bad input). */
+/* Read the four dictionaries strictly (fatal with file:line on bad input).  The walls are
+ * those of t = 0 (the geometry as written); lub_refcase_move takes them to another time. */
 void lub_refcase_read(lub_refcase *rc, const lub_case *c);
 void lub_refcase_free(lub_refcase *rc);
+
+/* The lower and upper wall at time t >= 0: each rigid wall translated from its place in
+ * system/particleGenDict.yaml (t = 0) by its movingWalls velocity times t, as lubFoam moves
+ * the particles of a moving patch (a periodic domain's wrap is not applied: a wall that has
+ * left [inlet, outlet] is an error when the gap is sampled).  A wall sliding along itself
+ * (the rigid wedge's plane) keeps its surface, so that the gap, and the reference, do not
+ * change with t.  node: the dictionary entry t came from, named by the errors of
+ * lub_refgap_sample at that time (NULL: it came from the command line). */
+void lub_refcase_move(lub_refcase *rc, double t, const lub_node *node);
 
 /* The gap on the reference grid: h at the n + 1 nodes and n face midpoints, dh/dt at the
  * nodes, and the minimum gap h0 (refined between samples by a parabola) and its position. */
@@ -86,8 +100,9 @@ typedef struct {
 } lub_refgap;
 
 /* Sample h (and dh/dt from the wall velocities: normal speeds, and each surface carried
- * along x) between the inlet and outlet; fatal (naming reynoldsRefDict.yaml:line) when a wall
- * does not span the interval or the gap is <= 0. */
+ * along x) of the walls at time rc->t between the inlet and outlet; fatal (naming
+ * reynoldsRefDict.yaml:line) when a wall does not span the interval or the gap is <= 0 (at
+ * t > 0 with the time at which the moving walls touch). */
 void lub_refgap_sample(lub_refgap *G, const lub_refcase *rc);
 void lub_refgap_free(lub_refgap *G);
 

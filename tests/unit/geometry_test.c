@@ -685,6 +685,304 @@ static void test_levels_arc(void)
     lub_geometry_free(&g);
 }
 
+/* ---- closed polygons ------------------------------------------------------------------ */
+
+/* Reading: orientation (stored counter-clockwise whatever the input), the repeated closing
+ * vertex dropped, the bad polygons refused at their line; the wall functions of the pad
+ * (0, 0.2), (4, 0.1), (4, 1), (0, 1) by hand: lower surface y = 0.2 - 0.025 x. */
+static void test_polygon_read(void)
+{
+    lub_geometry g;
+    read_text(&g, "dimension: 2\nl0: 0.1\ndomain: { min: [-1, -1], max: [5, 2] }\nwalls:\n"
+                  "  pad: { type: polygon, points: [[0, 1], [4, 1], [4, 0.1], [0, 0.2], [0, 1]] }\n"
+                  "  tri: { type: polygon, points: [[1, -0.5], [2, -0.5], [1.5, -0.2]] }\n");
+    const lub_wall *w = &g.walls[0];
+    CHECK(w->type == LUB_WALL_POLYGON && w->npts == 4);
+    double area2 = 0;
+    for (int i = 0; i < 4; i++) {
+        int j = (i + 1) % 4;
+        area2 += w->pts[2 * i] * w->pts[2 * j + 1] - w->pts[2 * j] * w->pts[2 * i + 1];
+    }
+    CHECK_NEAR(area2, 2 * 4 * (1 - 0.15), 1e-12); /* counter-clockwise: positive */
+    CHECK(g.walls[1].npts == 3);
+    double y;
+    CHECK(lub_wall_height(w, 2.0, 1, &y) && fabs(y - 0.15) < 1e-15);
+    CHECK(lub_wall_height(w, 2.0, 0, &y) && y == 1.0);
+    CHECK(lub_wall_height(w, 0.0, 1, &y) && fabs(y - 0.2) < 1e-15); /* the front face's foot */
+    CHECK(lub_wall_height(w, 4.0, 1, &y) && fabs(y - 0.1) < 1e-15);
+    CHECK(!lub_wall_height(w, 4.5, 1, &y));
+    double k = sqrt(1 + 0.025 * 0.025);
+    CHECK_NEAR(lub_wall_distance(w, (double[]){2, 0.5}, 2), -0.35 / k, 1e-14);
+    CHECK_NEAR(lub_wall_distance(w, (double[]){2, 0}, 2), 0.15 / k, 1e-14);
+    CHECK_NEAR(lub_wall_distance(w, (double[]){5, 1.5}, 2), hypot(1, 0.5), 1e-14);
+    CHECK_NEAR(lub_wall_distance(w, (double[]){0.1, 0.9}, 2), -0.1, 1e-14);
+    /* translated by (0.5, -0.05): the lower surface at x = 2.5 is 0.15 - 0.05 */
+    lub_wall m;
+    m.pts = lub_malloc(8 * sizeof *m.pts);
+    lub_wall_translate(&m, w, (double[]){0.5, -0.05, 0});
+    CHECK(lub_wall_height(&m, 2.5, 1, &y) && fabs(y - 0.1) < 1e-15);
+    CHECK(m.pts != w->pts && w->pts[0] == 0.0);
+    free(m.pts);
+    lub_geometry_free(&g);
+
+    const char *head = "dimension: 2\nl0: 0.1\ndomain: { min: [-1, -1], max: [5, 2] }\nwalls:\n";
+    char text[512];
+#define POLY_BAD(points, sub)                                                                      \
+    snprintf(text, sizeof text, "%s  p: { type: polygon, points: %s }\n", head, points);           \
+    CHECK_BAD(text, 5, sub)
+    POLY_BAD("[[0, 0], [1, 0]]", "needs at least 3 different points, found 2");
+    POLY_BAD("[[0, 0], [1, 0], [0, 0]]", "needs at least 3 different points, found 2");
+    POLY_BAD("[[0, 0], [1, 1], [1, 0], [0, 1]]", "cross or touch");
+    POLY_BAD("[[0, 0], [2, 0], [2, 1], [1, 0], [1, -1]]", "cross or touch");
+    POLY_BAD("[[0, 0], [1, 0], [1, 0], [0, 1]]", "point 2 repeats point 1");
+    POLY_BAD("[[0, 0], [2, 0], [1, 0], [1, 1]]", "the edges at point 1 fold back");
+    POLY_BAD("[[0, 0], [1], [0, 1]]", "point 1 must be [x, y]");
+#undef POLY_BAD
+    CHECK_BAD("dimension: 3\nl0: 0.1\ndomain: { min: [-1, -1, -1], max: [5, 2, 1] }\nwalls:\n"
+              "  p: { type: polygon, points: [[0, 0], [1, 0], [0, 1]] }\n",
+              5, "type 'polygon' is 2-D only");
+}
+
+/* Length along the closed boundary of polygon w (counter-clockwise from vertex 0) of the
+ * point x on it: the edge nearest to x, computed here for the test. */
+static double boundary_arc(const lub_wall *w, const double *x)
+{
+    double s = 0, best = INFINITY, at = 0;
+    for (int i = 0; i < w->npts; i++) {
+        const double *a = w->pts + 2 * i, *b = w->pts + 2 * ((i + 1) % w->npts);
+        double tx = b[0] - a[0], ty = b[1] - a[1], len = hypot(tx, ty);
+        double q = ((x[0] - a[0]) * tx + (x[1] - a[1]) * ty) / len;
+        q = q < 0 ? 0 : q > len ? len : q;
+        double d = hypot(a[0] + q * tx / len - x[0], a[1] + q * ty / len - x[1]);
+        if (d < best - 1e-12) best = d, at = s + q;
+        s += len;
+    }
+    return at;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The checks every polygon body must pass (patch w of P, level lev, spacing l0, dummy
+ * layers L): wall particles on the boundary (round-off), consecutive along it between
+ * gap_lo and gap_hi apart (the closing step included, so no gap anywhere), no two particles
+ * of the body within 0.5 l0, dummies inside at depths from l0 to L l0 / sin(45 deg) (the
+ * mitre of a right-angled concave corner), no fluid inside the body or closer than 0.999 l0
+ * to a particle of it.  Returns the number of wall particles. */
+static size_t check_polygon_body(const lub_geometry *g, const lub_particles *P, int w, int lev,
+                                 double l0, double gap_lo, double gap_hi)
+{
+    const lub_wall *pw = &g->walls[w];
+    int L = g->dummy_layers, bad_on = 0, bad_dummy = 0, bad_fluid = 0;
+    double perimeter = 0;
+    for (int i = 0; i < pw->npts; i++) {
+        int j = (i + 1) % pw->npts;
+        perimeter +=
+            hypot(pw->pts[2 * j] - pw->pts[2 * i], pw->pts[2 * j + 1] - pw->pts[2 * i + 1]);
+    }
+    double *s = lub_malloc((P->n + 1) * sizeof *s), dmin = INFINITY;
+    size_t nw = 0;
+    for (size_t i = 0; i < P->n; i++) {
+        double x[2] = {P->x[0][i], P->x[1][i]}, d = lub_wall_distance(pw, x, 2);
+        if (P->kind[i] == LUB_FLUID) {
+            if (d < 0) bad_fluid++;
+            continue;
+        }
+        if (P->patch[i] != w || P->level[i] != lev) continue;
+        if (P->kind[i] == LUB_WALL) {
+            if (fabs(d) > 1e-12 * (1 + perimeter)) bad_on++;
+            s[nw++] = boundary_arc(pw, x);
+        } else if (!(d <= -l0 * (1 - 1e-9) && d >= -L * l0 * sqrt(2.0) * (1 + 1e-9))) {
+            bad_dummy++;
+        }
+        for (size_t j = 0; j < P->n; j++) {
+            if (j == i) continue;
+            double r = hypot(P->x[0][j] - x[0], P->x[1][j] - x[1]);
+            if (P->kind[j] == LUB_FLUID) {
+                if (r < 0.999 * l0) bad_fluid++;
+            } else if (P->patch[j] == w) {
+                dmin = fmin(dmin, r);
+            }
+        }
+    }
+    CHECK(bad_on == 0);
+    CHECK(bad_dummy == 0);
+    CHECK(bad_fluid == 0);
+    CHECK(dmin >= 0.5 * l0);
+    qsort(s, nw, sizeof *s, cmp_double);
+    double glo = INFINITY, ghi = 0;
+    for (size_t i = 0; i < nw; i++) {
+        double gap = i + 1 < nw ? s[i + 1] - s[i] : s[0] + perimeter - s[i];
+        glo = fmin(glo, gap), ghi = fmax(ghi, gap);
+    }
+    if (!(glo >= gap_lo - 1e-12 && ghi <= gap_hi + 1e-12))
+        printf("  spacing along the boundary from %.15g to %.15g, expected [%g, %g]\n", glo, ghi,
+               gap_lo, gap_hi);
+    CHECK(glo >= gap_lo - 1e-12 && ghi <= gap_hi + 1e-12);
+    free(s);
+    return nw;
+}
+
+/* PND (T-4) at particle i over all particles, with re = 3.1 l0 and w = (1 - r/re)^2. */
+static double pnd_at(const lub_particles *P, size_t i, double l0)
+{
+    double re = 3.1 * l0, n = 0;
+    for (size_t j = 0; j < P->n; j++) {
+        double r = hypot(P->x[0][j] - P->x[0][i], P->x[1][j] - P->x[1][i]);
+        if (j != i && r < re) n += (1 - r / re) * (1 - r / re);
+    }
+    return n;
+}
+
+/* A square of side 2 = 20 l0 about (0.52, 0.31), turned by 30 degrees, given clockwise from
+ * an arbitrary corner, in oil: 4 x 20 wall particles exactly l0 apart along the boundary
+ * (the perimeter over l0), the dummy layers the squares of side 18 and 16 l0 inside
+ * (4 x 18 + 4 x 16 = 136); the fluid lattice stays out of it. */
+static void test_polygon_square(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    char text[1024], pts[512] = "";
+    double c = cos(M_PI / 6), s = sin(M_PI / 6);
+    const double corner[4][2] = {{1, 1}, {1, -1}, {-1, -1}, {-1, 1}}; /* clockwise */
+    for (int k = 0; k < 4; k++) {
+        int i = (k + 2) % 4; /* start at the third corner */
+        double x = 0.52 + c * corner[i][0] - s * corner[i][1];
+        double y = 0.31 + s * corner[i][0] + c * corner[i][1];
+        snprintf(pts + strlen(pts), sizeof pts - strlen(pts), "%s[%.17g, %.17g]", k ? ", " : "", x,
+                 y);
+    }
+    snprintf(text, sizeof text,
+             "dimension: 2\nl0: 0.1\ndomain: { min: [-2, -2], max: [3, 3] }\nwalls:\n"
+             "  sq: { type: polygon, points: [%s] }\n"
+             "fluid:\n  - { type: box, min: [-2, -2], max: [3, 3] }\n",
+             pts);
+    generate(text, &g, &P, NULL);
+    CHECK(count_of(&P, LUB_WALL, -1) == 80);
+    CHECK(count_of(&P, LUB_DUMMY, -1) == 136);
+    CHECK(check_polygon_body(&g, &P, 0, 0, 0.1, 0.1, 0.1) == 80);
+    CHECK(count_of(&P, LUB_FLUID, -1) > 1500);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+/* A concave L-shape, [0, 3] x [0, 1] and [0, 1] x [0, 2.5], in oil, l0 = 0.1 and the
+ * lattice through 0: the wall particles are the 2 (3 + 2.5) / l0 = 110 lattice points of
+ * the boundary, dummy layer j the L-shape moved j l0 in (its concave corner along the
+ * mitre to (1 - j l0, 1 - j l0)) with 2 (3 + 2.5) / l0 - 8 j points: 102 + 94.  The layers
+ * fill the body like the lattice: the PND (T-4) of every wall particle is n0 of the full
+ * lattice less the points 3 l0 deep, which no layer reaches (w(3 l0) for a particle on a
+ * straight edge, 2 w(3 l0) at the concave corner, none at a convex one), never more. */
+static void test_polygon_concave(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    generate("dimension: 2\nl0: 0.1\ndomain: { min: [-1.05, -1.05], max: [4.05, 3.55] }\n"
+             "walls:\n  ell: { type: polygon, points: [[1, 2.5], [0, 2.5], [0, 0], [3, 0], "
+             "[3, 1], [1, 1]] }\n"
+             "fluid:\n  - { type: box, min: [-1.05, -1.05], max: [4.05, 3.55] }\n",
+             &g, &P, NULL);
+    CHECK(count_of(&P, LUB_WALL, -1) == 110);
+    CHECK(count_of(&P, LUB_DUMMY, -1) == 102 + 94);
+    CHECK(check_polygon_body(&g, &P, 0, 0, 0.1, 0.1, 0.1) == 110);
+    double n0 = P.levels[0].n0, w3 = (1 - 3 / 3.1) * (1 - 3 / 3.1);
+    int bad = 0, corner = 0;
+    for (size_t i = 0; i < P.n; i++) {
+        if (P.kind[i] != LUB_WALL) continue;
+        double n = pnd_at(&P, i, 0.1), x = P.x[0][i], y = P.x[1][i];
+        int concave = fabs(x - 1) < 1e-9 && fabs(y - 1) < 1e-9;
+        int convex = 0;
+        const double vx[5][2] = {{0, 0}, {3, 0}, {3, 1}, {1, 2.5}, {0, 2.5}};
+        for (int k = 0; k < 5; k++) convex |= hypot(x - vx[k][0], y - vx[k][1]) < 1e-9;
+        double missing = concave ? 2 * w3 : convex ? 0 : w3;
+        /* a straight-edge particle within 3 l0 of a corner may miss less: between */
+        if (!(n <= n0 * (1 + 1e-12) && n >= n0 - missing - 1e-9 * n0)) bad++;
+        if (concave) {
+            corner++;
+            CHECK_NEAR(n, n0 - 2 * w3, 1e-9 * n0);
+        }
+    }
+    CHECK(bad == 0);
+    CHECK(corner == 1);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+/* The pad of an inclined slider: (0, 0.2), (4, 0.1), (4, 1), (0, 1), given clockwise, over a
+ * plane with oil between.  Wall particles: round(length / l0) steps per edge, 40 + 9 + 40 + 8
+ * = 97 (the perimeter 97.0125 l0), l0 apart but on the inclined face 4.00125 / 40 =
+ * 1.0003 l0; dummies inside; no oil in the pad; the gap of the plane to the pad's lower
+ * face filled (the column x = 2.05: the face at 0.14875, oil at 0.1 only, the rows one l0
+ * from both walls). */
+static void test_polygon_pad(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    size_t rc[1];
+    generate("dimension: 2\nl0: 0.1\ndomain: { min: [-1, -0.3], max: [5, 2] }\n"
+             "walls:\n  floor: { type: plane, point: [0, -0.1], normal: [0, 1] }\n"
+             "  pad: { type: polygon, points: [[0, 1], [4, 1], [4, 0.1], [0, 0.2]] }\n"
+             "fluid:\n  - { type: layer, wall: floor, thickness: 0.6 }\n",
+             &g, &P, rc);
+    size_t nw = 0;
+    for (size_t i = 0; i < P.n; i++) nw += P.kind[i] == LUB_WALL && P.patch[i] == 1;
+    CHECK(nw == 97);
+    CHECK(check_polygon_body(&g, &P, 1, 0, 0.1, 0.1, 4.00125 / 40 * (1 + 1e-12)) == 97);
+    size_t col = 0;
+    for (size_t i = 0; i < P.n; i++)
+        if (P.kind[i] == LUB_FLUID && fabs(P.x[0][i] - 2.05) < 1e-9) col++;
+    CHECK(col == 1);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+/* A polygon across two levels: the block [0, 4] x [0, 1], fine l0 = 0.05 in [1, 2], coarse
+ * 0.1 elsewhere.  Each level has the body where it owns x, sampled at its own l0: fine
+ * wall particles at x = 1, 1.05 .. 2 on the lower and upper face (2 x 21), coarse ones on
+ * the rest of the boundary, 2 (40 + 10) - 2 x 11 = 78; the fine level's particles of the
+ * range [0.775, 2.225] (the multi-resolution overlap: discretise_range), 2 x 29 wall
+ * particles (x = 0.8 .. 2.2), lie on the same boundary l0 apart. */
+static void test_polygon_levels(void)
+{
+    lub_geometry g;
+    lub_particles P, R;
+    generate("dimension: 2\nlevels:\n  - { l0: 0.05, region: [1, 2] }\n  - { l0: 0.1 }\n"
+             "domain: { min: [-1, -1], max: [5, 2] }\n"
+             "walls:\n  block: { type: polygon, points: [[0, 0], [4, 0], [4, 1], [0, 1]] }\n",
+             &g, &P, NULL);
+    CHECK(count_of(&P, LUB_WALL, 0) == 42);
+    CHECK(count_of(&P, LUB_WALL, 1) == 78);
+    int bad = 0;
+    for (size_t i = 0; i < P.n; i++) {
+        double x = P.x[0][i];
+        if ((x >= 1 && x <= 2) != (P.level[i] == 0)) bad++;
+        if (P.kind[i] == LUB_WALL &&
+            fabs(lub_wall_distance(&g.walls[0], (double[]){x, P.x[1][i]}, 2)) > 1e-12)
+            bad++;
+    }
+    CHECK(bad == 0);
+    lub_geometry_discretise_range(&g, 0, 0.775, 2.225, &R);
+    CHECK(count_of(&R, LUB_WALL, 0) == 58);
+    bad = 0;
+    for (size_t i = 0; i < R.n; i++) {
+        double x = R.x[0][i], y = R.x[1][i];
+        if (R.kind[i] == LUB_WALL) {
+            double q = x / 0.05;
+            if (fabs(q - round(q)) > 1e-9 || !(fabs(y) < 1e-12 || fabs(y - 1) < 1e-12)) bad++;
+        } else if (R.kind[i] == LUB_DUMMY &&
+                   !(lub_wall_distance(&g.walls[0], (double[]){x, y}, 2) < -0.05 * (1 - 1e-9))) {
+            bad++;
+        }
+    }
+    CHECK(bad == 0);
+    lub_particles_free(&R);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
 int main(void)
 {
     RUN(test_read_wedge);
@@ -704,6 +1002,11 @@ int main(void)
     RUN(test_curves);
     RUN(test_between);
     RUN(test_bad_discretise);
+    RUN(test_polygon_read);
+    RUN(test_polygon_square);
+    RUN(test_polygon_concave);
+    RUN(test_polygon_pad);
+    RUN(test_polygon_levels);
     unlink(tmp_path);
     return test_summary();
 }

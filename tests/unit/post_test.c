@@ -9,8 +9,10 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "core/args.h"
+#include "geometry/discretise.h"
 #include "io/case.h"
 #include "io/particles_io.h"
 #include "particles/particles.h"
@@ -283,11 +285,60 @@ static void test_arc(void)
     x[0] = 1.0, x[1] = 1.5;
     CHECK(lub_wall_arc(&w, 2, x, &s) == 0);
     CHECK_NEAR(s, 2.5, 1e-14);
+    /* polygon (0,0) (1,0) (1,2) closed back to (0,0): (0.5, 1) on the closing edge is at
+     * s = 1 + 2 + sqrt(5)/2 */
+    w.type = LUB_WALL_POLYGON;
+    x[0] = 0.5, x[1] = 1.0;
+    CHECK(lub_wall_arc(&w, 2, x, &s) == 0);
+    CHECK_NEAR(s, 3 + sqrt(5.0) / 2, 1e-14);
     /* unsupported */
     w.type = LUB_WALL_BOX;
     CHECK(lub_wall_arc(&w, 2, x, &s) == -1);
     w.type = LUB_WALL_CYLINDER;
     CHECK(lub_wall_arc(&w, 3, x, &s) == -1);
+}
+
+/* The wall particles facing down and up (lub_wall_facing) of particleGen's bodies: the pad
+ * (0, 0.2), (4, 0.1), (4, 1), (0, 1) with l0 = 0.1 has 40 steps on its lower face, 41
+ * particles with the corners, all on y = 0.2 - 0.025 x, and 41 on its top; a whole circle
+ * (R = 0.5, round(2 pi R / l0) = 31 particles at angles k 2 pi/31 from its lowest point)
+ * those within 60 degrees of the bottom, |k| <= 5 (11), and of the top, k = 11 .. 20 (10). */
+static void test_wall_facing(void)
+{
+    const char *path = "/tmp/lub_post_test_facing.yaml";
+    FILE *f = fopen(path, "w");
+    fputs("dimension: 2\nl0: 0.1\ndomain: { min: [-1, -1], max: [5, 5] }\nwalls:\n"
+          "  pad: { type: polygon, points: [[0, 0.2], [4, 0.1], [4, 1], [0, 1]] }\n"
+          "  ring: { type: cylinder, centre: [2, 3], radius: 0.5 }\n",
+          f);
+    fclose(f);
+    lub_geometry g;
+    lub_particles P;
+    lub_geometry_read(&g, path);
+    lub_geometry_discretise(&g, &P, 0.0, NULL);
+    unlink(path);
+    unsigned char *on = malloc(P.n);
+    size_t n = lub_wall_facing(&P, 0, -1, on);
+    CHECK(n == 41);
+    int bad = 0;
+    for (size_t i = 0; i < P.n; i++)
+        if (on[i] && (P.patch[i] != 0 || fabs(P.x[1][i] - (0.2 - 0.025 * P.x[0][i])) > 1e-12))
+            bad++;
+    CHECK(bad == 0);
+    CHECK(lub_wall_facing(&P, 0, 1, on) == 41);
+    for (size_t i = 0; i < P.n; i++)
+        if (on[i] && fabs(P.x[1][i] - 1.0) > 1e-12) bad++;
+    CHECK(bad == 0);
+    CHECK(lub_wall_facing(&P, 1, -1, on) == 11);
+    for (size_t i = 0; i < P.n; i++)
+        if (on[i] && !(P.x[1][i] < 3 - 0.5 * cos(5.5 * 2 * M_PI / 31))) bad++;
+    CHECK(lub_wall_facing(&P, 1, 1, on) == 10);
+    for (size_t i = 0; i < P.n; i++)
+        if (on[i] && !(P.x[1][i] > 3 - 0.5 * cos(10.5 * 2 * M_PI / 31))) bad++;
+    CHECK(bad == 0);
+    free(on);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
 }
 
 /* ---- film ----------------------------------------------------------------------------- */
@@ -400,6 +451,7 @@ int main(int argc, char **argv)
     RUN(test_sample_point);
     RUN(test_totals);
     RUN(test_arc);
+    RUN(test_wall_facing);
     RUN(test_film);
     return test_summary();
 }

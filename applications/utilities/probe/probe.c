@@ -23,14 +23,18 @@
 
 static const char *description =
     "Subcommands (one per run; without one, the sets of system/probeDict.yaml are run):\n"
-    "  wallPressure -patch NAME [-field LIST] [-bin DX] [-arc] [-from A -to B]\n"
+    "  wallPressure -patch NAME [-field LIST] [-bin DX] [-arc] [-facing DIR] [-from A -to B]\n"
     "      the wall particles (kind wall, not the dummies) of a patch.  Without -bin one row\n"
     "      per particle, sorted by x: '# x y p' (with -arc: '# s x y p'; -average: per\n"
     "      particle id); with -bin DX the mean per bin of x (or s): '# x p n'.  -arc:\n"
     "      against the arc length s along the wall of system/particleGenDict.yaml (2-D\n"
     "      cylinder: s = R theta from its lowest point, positive towards +x; plane,\n"
-    "      segment, polyline: length along it).  Multi-resolution, with -bin: the wall\n"
-    "      particles in the part of x their level owns, each x once.\n"
+    "      segment, polyline: length along it; polygon: along its closed boundary from its\n"
+    "      first vertex, counter-clockwise).  -facing down (up): only the wall particles\n"
+    "      whose surface faces down (up), within 60 degrees (the normal from the centroid of\n"
+    "      the dummy particles behind them): the lower face of a closed body (a polygon pad\n"
+    "      over a film) without its top and steep faces, each x once.  Multi-resolution,\n"
+    "      with -bin: the wall particles in the part of x their level owns, each x once.\n"
     "  line [-field LIST] [-from X0 -to X1] [-bin DX]\n"
     "      the fluid particles binned by x: per bin the mean over the film thickness of each\n"
     "      field and the count n of samples: '# x p n'.\n"
@@ -136,14 +140,14 @@ static const char *description =
     "-at point list or -average window, and bad dictionaries (file:line).";
 
 /* Which options each subcommand takes. */
-enum { O_PATCH, O_FIELD, O_FROM, O_TO, O_BIN, O_ARC, O_AT, O_DIMLESS, O_N };
-static const char *const opt_names[O_N] = {"-patch", "-field", "-from", "-to",
-                                           "-bin",   "-arc",   "-at",   "-dimensionless"};
+enum { O_PATCH, O_FIELD, O_FROM, O_TO, O_BIN, O_ARC, O_AT, O_DIMLESS, O_FACING, O_N };
+static const char *const opt_names[O_N] = {"-patch", "-field", "-from",          "-to",    "-bin",
+                                           "-arc",   "-at",    "-dimensionless", "-facing"};
 static const int applies[PROBE_NKINDS][O_N] = {
-    [PROBE_WALL] = {1, 1, 1, 1, 1, 1, 0, 1},   [PROBE_LINE] = {0, 1, 1, 1, 1, 0, 0, 1},
-    [PROBE_POINTS] = {0, 1, 0, 0, 0, 0, 1, 1}, [PROBE_FILM] = {0, 0, 1, 1, 1, 0, 0, 1},
-    [PROBE_TOTALS] = {1, 0, 0, 0, 0, 0, 0, 0}, [PROBE_SHAPE] = {1, 0, 1, 1, 0, 0, 0, 1},
-    [PROBE_FRONT] = {0, 0, 0, 0, 0, 0, 0, 0},
+    [PROBE_WALL] = {1, 1, 1, 1, 1, 1, 0, 1, 1},   [PROBE_LINE] = {0, 1, 1, 1, 1, 0, 0, 1, 0},
+    [PROBE_POINTS] = {0, 1, 0, 0, 0, 0, 1, 1, 0}, [PROBE_FILM] = {0, 0, 1, 1, 1, 0, 0, 1, 0},
+    [PROBE_TOTALS] = {1, 0, 0, 0, 0, 0, 0, 0, 0}, [PROBE_SHAPE] = {1, 0, 1, 1, 0, 0, 0, 1, 0},
+    [PROBE_FRONT] = {0, 0, 0, 0, 0, 0, 0, 0, 0},
 };
 
 static const char *in_case(const lub_case *c, const char *path, char *buf)
@@ -167,7 +171,8 @@ static probe_kind find_kind(const char *name)
 
 int main(int argc, char **argv)
 {
-    static const char *patch = NULL, *field = NULL, *at = NULL, *average = NULL, *out = NULL;
+    static const char *patch = NULL, *field = NULL, *at = NULL, *average = NULL, *out = NULL,
+                      *facing = NULL;
     static double from = NAN, to = NAN, bin = NAN;
     static int arc = 0, dimensionless = 0;
     static lub_strlist set_names = {0};
@@ -180,6 +185,10 @@ int main(int argc, char **argv)
         {"-bin", "DX", "bin width (wallPressure: bins instead of one row per particle)",
          LUB_OPT_REAL, &bin},
         {"-arc", NULL, "wallPressure: against the arc length s along the wall", LUB_OPT_FLAG, &arc},
+        {"-facing", "DIR",
+         "wallPressure: only the wall particles facing DIR (down or up): a body's lower "
+         "(upper) face",
+         LUB_OPT_STR, &facing},
         {"-at", "'x y; x y'", "points: where to sample", LUB_OPT_STR, &at},
         {"-average", "T0:T1", "average over the selected times in [T0, T1]", LUB_OPT_STR, &average},
         {"-dimensionless", NULL, "add X (S), P, H columns (thesis T-38, T-39)", LUB_OPT_FLAG,
@@ -216,8 +225,17 @@ int main(int argc, char **argv)
         lub_fatal("-average '%s': expected a time window T0:T1 with T0 <= T1, e.g. -average "
                   "0.024:0.030",
                   average);
-    int given[O_N] = {patch != NULL, field != NULL, !isnan(from), !isnan(to),
-                      !isnan(bin),   arc,           at != NULL,   dimensionless};
+    int facing_dir = 0;
+    if (facing) {
+        if (strcmp(facing, "down") == 0)
+            facing_dir = -1;
+        else if (strcmp(facing, "up") == 0)
+            facing_dir = 1;
+        else
+            lub_fatal("-facing '%s': expected down or up", facing);
+    }
+    int given[O_N] = {patch != NULL, field != NULL, !isnan(from),  !isnan(to),    !isnan(bin),
+                      arc,           at != NULL,    dimensionless, facing != NULL};
 
     probe_ctx x;
     memset(&x, 0, sizeof x);
@@ -250,6 +268,7 @@ int main(int argc, char **argv)
         s.to = to;
         s.bin = bin;
         s.arc = arc;
+        s.facing = facing_dir;
         s.dimensionless = dimensionless;
         if (average) s.average = 1, s.t0 = t0, s.t1 = t1;
         char err[512];

@@ -40,6 +40,7 @@ typedef struct {
     char fields[1024]; /* comma-separated field list (default "p") */
     double from, to, bin;
     int arc;     /* wallPressure: against arc length */
+    int facing;  /* wallPressure: -1 (+1) only the wall particles facing down (up), 0 all */
     double *pts; /* points: npts x 3 (z = 0 in 2-D), owned */
     size_t npts;
     int pts_dim; /* coordinates given per point */

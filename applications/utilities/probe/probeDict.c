@@ -201,7 +201,11 @@ static void read_set(probe_spec *s, const char *name, lub_node *m)
         s->patch_node = lub_dict_find(m, "patch");
         s->patch = s->patch_node ? lub_dict_str(m, "patch") : NULL;
     }
-    if (kind == PROBE_WALL) s->arc = lub_dict_bool_or(m, "arc", 0);
+    if (kind == PROBE_WALL) {
+        s->arc = lub_dict_bool_or(m, "arc", 0);
+        static const char *const facing[] = {"all", "down", "up", NULL};
+        s->facing = (int[]){0, -1, 1}[lub_dict_choice(m, "facing", facing, 0)];
+    }
     if (kind == PROBE_WALL || kind == PROBE_LINE || kind == PROBE_POINTS) read_fields(s, m);
     if (kind == PROBE_WALL || kind == PROBE_LINE || kind == PROBE_FILM || kind == PROBE_SHAPE) {
         s->from = lub_dict_real_or(m, "from", NAN, LUB_ANY);

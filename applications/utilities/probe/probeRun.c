@@ -411,10 +411,21 @@ static const lub_wall *arc_wall(job *j)
     double x0[3] = {0, 0, 0}, dummy;
     if (lub_wall_arc(&g->walls[w], g->dim, x0, &dummy) != 0)
         probe_error(s->node,
-                    "-arc: arc length is defined along 2-D cylinder, plane, segment and "
-                    "polyline walls; wall '%s' is not one of them%s",
+                    "-arc: arc length is defined along 2-D cylinder, plane, segment, polyline and "
+                    "polygon walls; wall '%s' is not one of them%s",
                     s->patch, g->dim == 3 ? " (the case is 3-D)" : "");
     return &g->walls[w];
+}
+
+/* -facing: no coordinate (NAN) for the wall particles of the patch that do not face the
+ * direction asked for (lub_wall_facing). */
+static void facing_filter(job *j, int patch, double *coord)
+{
+    unsigned char *on = lub_malloc(j->P.n ? j->P.n : 1);
+    lub_wall_facing(&j->P, patch, j->s->facing, on);
+    for (size_t i = 0; i < j->P.n; i++)
+        if (j->P.kind[i] == LUB_WALL && j->P.patch[i] == patch && !on[i]) coord[i] = NAN;
+    free(on);
 }
 
 static void run_wall_binned(job *j)
@@ -449,11 +460,12 @@ static void run_wall_binned(job *j)
          * once, as the wallPressure function object and the elasticWall load): the others
          * get no coordinate */
         const lub_levels *L = j->P.nlevels > 1 ? ctx_levels(j->x, &j->P) : NULL;
+        if ((L || j->s->facing) && !w) {
+            coord = lub_realloc(coord, (j->P.n ? j->P.n : 1) * sizeof *coord);
+            memcpy(coord, j->P.x[0], j->P.n * sizeof *coord);
+        }
+        if (j->s->facing) facing_filter(j, patch, coord);
         if (L) {
-            if (!w) {
-                coord = lub_realloc(coord, (j->P.n ? j->P.n : 1) * sizeof *coord);
-                memcpy(coord, j->P.x[0], j->P.n * sizeof *coord);
-            }
             for (size_t i = 0; i < j->P.n; i++) {
                 if (j->P.kind[i] != LUB_WALL) continue;
                 lub_level_where lw;
@@ -494,6 +506,7 @@ static void run_wall_particles(job *j)
             arc_coords(j, w, patch, coord);
         else
             memcpy(coord, j->P.x[0], j->P.n * sizeof *coord);
+        if (s->facing) facing_filter(j, patch, coord);
         if (it == 0) {
             job_fields(j);
             dim = j->P.dim;
@@ -516,7 +529,8 @@ static void run_wall_particles(job *j)
         double row[LUB_POST_MAX_COLS + 8];
         for (size_t i = 0; i < j->P.n; i++) {
             if (j->P.kind[i] != LUB_WALL || j->P.patch[i] != patch) continue;
-            if ((!isnan(s->from) && coord[i] < s->from) || (!isnan(s->to) && coord[i] > s->to))
+            if (isnan(coord[i]) || (!isnan(s->from) && coord[i] < s->from) ||
+                (!isnan(s->to) && coord[i] > s->to))
                 continue;
             id_row key = {j->P.id[i], 0}, *hit = bsearch(&key, ids, nids, sizeof *ids, id_cmp);
             if (!hit)

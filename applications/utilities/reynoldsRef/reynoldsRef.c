@@ -1,10 +1,13 @@
 /* reynoldsRef: the 1-D Reynolds-equation reference of a case (methods.md 5, thesis 3-2).
  *
  * Reads the case's geometry (system/particleGenDict.yaml), oil (transportProperties), wall
- * motion (models.yaml movingWalls) and system/reynoldsRefDict.yaml; samples the gap
- * h(x) = (upper wall height) - (lower wall height) on a uniform grid between the inlet and
- * the outlet; solves the Reynolds equation (T-32) with the chosen boundary condition; writes
- * postProcessing/reynoldsRef/<time>/p.dat (# x p h [X P H]) and prints a short report.
+ * motion (models.yaml movingWalls) and system/reynoldsRefDict.yaml; for each time asked for
+ * (the dictionary's `time`, or the time folders -time / -latestTime select) moves the walls
+ * by their velocities to that time, samples the gap h(x) = (upper wall height) - (lower wall
+ * height) on a uniform grid between the inlet and the outlet, solves the Reynolds equation
+ * (T-32, methods2.md (9.1) with the squeeze term dh/dt of the moving walls) with the chosen
+ * boundary condition, writes postProcessing/reynoldsRef/<time>/p.dat (# x p h [X P H]) and
+ * prints a short report.
  * With an elasticWall in models.yaml (soft EHL) the gap follows from the pressure and the
  * load instead (reynoldsRefEHL.c, src/reynolds/ehl.h).
  */
@@ -54,6 +57,72 @@ void reynoldsRef_table_write(const lub_case *c, const char *out_file, const char
         snprintf(written, LUB_PATH_MAX, "postProcessing/reynoldsRef/%s/p.dat", tname);
 }
 
+/* The report's line on the time of the walls: what moving them to t did to the gap. */
+static void report_time(const lub_refcase *rc, const lub_refgap *G)
+{
+    const double *vl = rc->vel[rc->wl], *vu = rc->vel[rc->wu];
+    if (rc->t == 0.0)
+        lub_message("at t        0 s (the walls of system/particleGenDict.yaml)");
+    else if (G->moving_shape)
+        lub_message("at t        %g s: the walls moved by their velocities, lower by (%g, %g) m, "
+                    "upper by (%g, %g) m",
+                    rc->t, vl[0] * rc->t, vl[1] * rc->t, vu[0] * rc->t, vu[1] * rc->t);
+    else
+        lub_message("at t        %g s (names the output; the gap does not change with time: "
+                    "no wall moves across the film)",
+                    rc->t);
+}
+
+/* The rigid reference at the walls' time rc->t: solve, write, report. */
+static void reference(const lub_case *c, const lub_refcase *rc, const lub_refgap *G,
+                      const char *out_file, const char *tname, int dimensionless, double t_start)
+{
+    const lub_refcase_settings *s = &rc->s;
+    double *p = lub_malloc((size_t)(G->n + 1) * sizeof *p);
+    lub_reynolds_result res;
+    double t_solve = lub_wtime();
+    lub_reynolds_status st = lub_refcase_solve(rc, G, p, &res);
+    t_solve = lub_wtime() - t_solve;
+    if (st != LUB_REYNOLDS_OK)
+        lub_fatal_run("the Reynolds solve failed: %s (%d cells on [%g, %g], %s, t = %g s)",
+                      lub_reynolds_status_string(st), G->n, G->xa, G->xb,
+                      lub_reynolds_bc_names[s->bc], rc->t);
+
+    /* output and report */
+    lub_refscales d;
+    if (dimensionless) lub_refcase_scales(rc, G, &d);
+    char written[LUB_PATH_MAX];
+    reynoldsRef_table_write(c, out_file, tname, G, G->h, p, dimensionless ? &d : NULL, written);
+
+    lub_message("grid        %d cells on [%g, %g] m, dx = %.4g m", G->n, G->xa, G->xb, G->dx);
+    lub_message("walls       lower '%s' U1 = %g m/s, upper '%s' U2 = %g m/s%s", s->lower, rc->u1,
+                s->upper, rc->u2, G->moving_shape ? ", dh/dt != 0 (wall motion)" : "");
+    lub_message("oil         rho = %g kg/m^3, nu = %g m^2/s, mu = %g Pa s", rc->rho, rc->nu,
+                rc->mu);
+    lub_message("gap         h0 = %.6g m (minimum, at x = %.6g m)", G->h0, G->x_h0);
+    lub_message("condition   %s%s", lub_reynolds_bc_names[s->bc],
+                s->bc == LUB_REYNOLDS_BC_REYNOLDS ? " (p >= 0; p = dp/dx = 0 at the free exit)"
+                                                  : "");
+    if (s->bc == LUB_REYNOLDS_BC_REYNOLDS)
+        lub_message("active set  %d iteration%s, %d cavitated nodes", res.iterations,
+                    res.iterations == 1 ? "" : "s", res.n_cavitated);
+    lub_message("exit        x = %.6g m%s", res.x_exit,
+                res.x_exit >= G->xb ? " (the outlet: the film is full up to it)" : "");
+    lub_message("peak        p = %.6g Pa at x = %.6g m", res.p_max, res.x_max);
+    lub_message("load        W = %.6g N/m", res.load);
+    if (dimensionless) {
+        lub_message("R, h0       R = %g m, h0 = %g m, sqrt(R h0) = %.6g m", d.radius, G->h0, d.sx);
+        lub_message("exit        X = %.5f (Martin, T-37: X = 0.475 sqrt(2) = %.5f)",
+                    res.x_exit / d.sx, 0.475 * sqrt(2.0));
+        lub_message("peak        P = %.5f at X = %.5f", res.p_max * d.sp, res.x_max / d.sx);
+        lub_message("load        W h0/(mu (U1+U2) R) = %.5f",
+                    res.load * G->h0 / (rc->mu * d.uref * d.radius));
+    }
+    lub_message("written     %s", written);
+    lub_message("time        solve %.3g s, total %.3g s", t_solve, lub_wtime() - t_start);
+    free(p);
+}
+
 int main(int argc, char **argv)
 {
     static int dimensionless = 0;
@@ -64,7 +133,9 @@ int main(int argc, char **argv)
          "add the thesis' X = x/sqrt(R h0), P (T-38, T-39), H = h/h0; soft EHL: X = x/b, "
          "P = p/p_H, H = h R/b^2 (T-54..T-58)",
          LUB_OPT_FLAG, &dimensionless},
-        {"-o", "FILE", "write the table to FILE ('-': standard output) instead of postProcessing",
+        {"-o", "FILE",
+         "write the table to FILE ('-': standard output) instead of postProcessing (one "
+         "time only)",
          LUB_OPT_STR, &out_file},
         {"-inlet", "X",
          "the inlet x instead of 'inlet' of system/reynoldsRefDict.yaml (e.g. the inlet "
@@ -86,6 +157,14 @@ int main(int argc, char **argv)
             "postProcessing/reynoldsRef/<time>/p.dat with columns x p h (and X P H with\n"
             "-dimensionless, which needs a cylinder as the upper wall: R its radius, h0 the\n"
             "minimum gap).\n"
+            "Time: the reference at time t takes the gap at t, every moving wall translated\n"
+            "by its velocity times t from its place in system/particleGenDict.yaml (t = 0),\n"
+            "as lubFoam moves it (a squeeze film: h(t) = h(0) - V t).  t is 'time' of\n"
+            "reynoldsRefDict.yaml (default 0), or each time folder of the case that -time,\n"
+            "-latestTime or -noZero select (one table per time, e.g. -time '0.001:0.003'\n"
+            "for every time a squeeze run wrote there).  Walls sliding along themselves\n"
+            "(a rigid wedge's plane) leave the gap as it is: t then only names the output.\n"
+            "A gap that has closed by t is an error giving the time the walls touch.\n"
             "Soft EHL (constant/models.yaml elasticWall, softEHL in reynoldsRefDict.yaml):\n"
             "the upper wall is an elastic cylinder carrying the load W; the gap\n"
             "h = h0 + x^2/(2R) + v(x), v from the half-space influence coefficients (thesis\n"
@@ -95,7 +174,7 @@ int main(int argc, char **argv)
         .dictionaries = "system/reynoldsRefDict.yaml\nsystem/particleGenDict.yaml\n"
                         "constant/transportProperties.yaml\nconstant/models.yaml\n"
                         "system/controlDict.yaml (timePrecision, optional)",
-        .time_selection = 0,
+        .time_selection = 1,
         .has_case = 1,
         .min_args = 0,
         .max_args = 0};
@@ -121,71 +200,46 @@ int main(int argc, char **argv)
     const lub_refcase_settings *s = &rc.s;
     if (dimensionless) lub_refcase_check_scales(&rc);
 
-    /* time folder name of the output, with the run's timePrecision (the solver owns the rest
-     * of controlDict, so it is not checked here) */
-    int precision = 6;
-    lub_dict *cd = lub_dict_read_optional(lub_case_path(&c, path, "system/controlDict.yaml"));
-    if (cd) {
-        precision = (int)lub_dict_int_or(lub_dict_root(cd), "timePrecision", 6, 1, 17);
-        lub_dict_free(cd);
+    /* the times: the time folders selected on the command line, else the dictionary's time,
+     * named with the run's timePrecision (the solver owns the rest of controlDict, so it is
+     * not checked here) */
+    lub_time *times;
+    size_t nt = 1;
+    int from_folders = a.time || a.latest_time || a.no_zero;
+    if (from_folders) {
+        nt = lub_case_select_times(&c, a.time, a.latest_time, a.no_zero, &times);
+    } else {
+        int precision = 6;
+        lub_dict *cd = lub_dict_read_optional(lub_case_path(&c, path, "system/controlDict.yaml"));
+        if (cd) {
+            precision = (int)lub_dict_int_or(lub_dict_root(cd), "timePrecision", 6, 1, 17);
+            lub_dict_free(cd);
+        }
+        times = lub_malloc(sizeof *times);
+        times[0].value = s->time;
+        lub_time_name(s->time, precision, times[0].name, sizeof times[0].name);
     }
-    char tname[64];
-    lub_time_name(s->time, precision, tname, sizeof tname);
+    if (out_file && nt > 1)
+        lub_fatal("-o writes one table, but the time selection has %zu times (%s to %s): "
+                  "select one, or leave out -o to write postProcessing/reynoldsRef/<time>/",
+                  nt, times[0].name, times[nt - 1].name);
+    for (size_t k = 0; k < nt; k++)
+        if (!(times[k].value >= 0.0))
+            lub_fatal("time folder '%s': the reference needs a time >= 0", times[k].name);
 
-    /* the gap, and the Reynolds equation on it */
-    lub_refgap G;
-    lub_refgap_sample(&G, &rc);
-    if (rc.ehl) { /* soft EHL: the gap follows from the pressure (reynoldsRefEHL.c) */
-        reynoldsRef_soft_ehl(&c, &rc, &G, out_file, tname, dimensionless, t_start);
+    for (size_t k = 0; k < nt; k++) {
+        /* the walls at t, the gap between them, and the Reynolds equation on it */
+        lub_refcase_move(&rc, times[k].value, from_folders ? NULL : s->time_node);
+        lub_refgap G;
+        lub_refgap_sample(&G, &rc);
+        report_time(&rc, &G);
+        if (rc.ehl) /* soft EHL: the gap follows from the pressure (reynoldsRefEHL.c) */
+            reynoldsRef_soft_ehl(&c, &rc, &G, out_file, times[k].name, dimensionless, t_start);
+        else
+            reference(&c, &rc, &G, out_file, times[k].name, dimensionless, t_start);
         lub_refgap_free(&G);
-        lub_refcase_free(&rc);
-        return 0;
     }
-
-    double *p = lub_malloc((size_t)(G.n + 1) * sizeof *p);
-    lub_reynolds_result res;
-    double t_solve = lub_wtime();
-    lub_reynolds_status st = lub_refcase_solve(&rc, &G, p, &res);
-    t_solve = lub_wtime() - t_solve;
-    if (st != LUB_REYNOLDS_OK)
-        lub_fatal_run("the Reynolds solve failed: %s (%d cells on [%g, %g], %s)",
-                      lub_reynolds_status_string(st), G.n, G.xa, G.xb,
-                      lub_reynolds_bc_names[s->bc]);
-
-    /* output and report */
-    lub_refscales d;
-    if (dimensionless) lub_refcase_scales(&rc, &G, &d);
-    char written[LUB_PATH_MAX];
-    reynoldsRef_table_write(&c, out_file, tname, &G, G.h, p, dimensionless ? &d : NULL, written);
-
-    lub_message("grid        %d cells on [%g, %g] m, dx = %.4g m", G.n, G.xa, G.xb, G.dx);
-    lub_message("walls       lower '%s' U1 = %g m/s, upper '%s' U2 = %g m/s%s", s->lower, rc.u1,
-                s->upper, rc.u2, G.moving_shape ? ", dh/dt != 0 (wall motion)" : "");
-    lub_message("oil         rho = %g kg/m^3, nu = %g m^2/s, mu = %g Pa s", rc.rho, rc.nu, rc.mu);
-    lub_message("gap         h0 = %.6g m (minimum, at x = %.6g m)", G.h0, G.x_h0);
-    lub_message("condition   %s%s", lub_reynolds_bc_names[s->bc],
-                s->bc == LUB_REYNOLDS_BC_REYNOLDS ? " (p >= 0; p = dp/dx = 0 at the free exit)"
-                                                  : "");
-    if (s->bc == LUB_REYNOLDS_BC_REYNOLDS)
-        lub_message("active set  %d iteration%s, %d cavitated nodes", res.iterations,
-                    res.iterations == 1 ? "" : "s", res.n_cavitated);
-    lub_message("exit        x = %.6g m%s", res.x_exit,
-                res.x_exit >= G.xb ? " (the outlet: the film is full up to it)" : "");
-    lub_message("peak        p = %.6g Pa at x = %.6g m", res.p_max, res.x_max);
-    lub_message("load        W = %.6g N/m", res.load);
-    if (dimensionless) {
-        lub_message("R, h0       R = %g m, h0 = %g m, sqrt(R h0) = %.6g m", d.radius, G.h0, d.sx);
-        lub_message("exit        X = %.5f (Martin, T-37: X = 0.475 sqrt(2) = %.5f)",
-                    res.x_exit / d.sx, 0.475 * sqrt(2.0));
-        lub_message("peak        P = %.5f at X = %.5f", res.p_max * d.sp, res.x_max / d.sx);
-        lub_message("load        W h0/(mu (U1+U2) R) = %.5f",
-                    res.load * G.h0 / (rc.mu * d.uref * d.radius));
-    }
-    lub_message("written     %s", written);
-    lub_message("time        solve %.3g s, total %.3g s", t_solve, lub_wtime() - t_start);
-
-    free(p);
-    lub_refgap_free(&G);
+    free(times);
     lub_refcase_free(&rc);
     return 0;
 }

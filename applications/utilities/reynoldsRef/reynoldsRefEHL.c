@@ -69,12 +69,14 @@ void reynoldsRef_soft_ehl(const lub_case *c, const lub_refcase *rc, const lub_re
     double t_solve = lub_wtime();
     lub_ehl_status st = lub_ehl_solve(&pb, &res);
     t_solve = lub_wtime() - t_solve;
-    if (st != LUB_EHL_OK)
+    if (st != LUB_EHL_OK) {
+        free(shape), free(shape_face), free(p), free(h); /* nothing left for LeakSanitizer */
         lub_fatal_run("the soft-EHL solve failed: %s after %d Newton iterations in %d "
                       "continuation stages (%d cells on [%g, %g]; last change of the film %.3g, "
                       "load error %.3g; softEHL maxIterations %ld, tolerance %g)",
                       lub_ehl_status_string(st), res.iterations, res.stages, n, G->xa, G->xb,
                       res.change, res.load_error, s->ehl_max_iterations, s->ehl_tolerance);
+    }
 
     lub_refscales d;
     if (dimensionless) lub_refcase_scales(rc, G, &d);
