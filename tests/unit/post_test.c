@@ -372,16 +372,20 @@ static void test_film(void)
     CHECK(lub_film_row_at(&f, 2, &r) == 1);
     CHECK(r.x == 2.5 && r.surface == 4.0 && r.bottom == 0.0 && r.contact == 0 && r.n == 4);
     CHECK(r.h == 4.0);
+    /* the cells cover [0, 0.5] (wall), [0.5, 4.5] (fluid), [6, 6.5] (wall) of the gap 6.5 */
+    CHECK(r.full == 0);
+    CHECK_NEAR(r.filled, 5.0 / 6.5, 1e-15);
     CHECK(lub_film_row_at(&f, 7, &r) == 1);
     CHECK(r.surface == 2.0 && r.bottom == 0.0 && r.contact == 1 && r.h == 3.0 && r.n == 2);
-    double in, out;
-    CHECK(lub_film_meniscus(&f, &in, &out) == 1);
-    CHECK(in == 5.0 && out == 10.0);
-    /* flow towards -x: the inlet is the upstream (+x) end of the contact run */
+    CHECK(r.full == 1 && r.filled == 1.0);
+    lub_film_ends e;
+    CHECK(lub_film_meniscus(&f, &e) == 1);
+    CHECK(e.inlet == 5.0 && e.outlet == 10.0 && e.contact == 5.0);
+    /* flow towards -x: the inlet is the upstream (+x) end of the full run */
     for (size_t i = 0; i < P.n; i++) P.u[0][i] = -1.0;
     lub_film_sample(&f, &P);
-    CHECK(lub_film_meniscus(&f, &in, &out) == 1);
-    CHECK(in == 10.0 && out == 5.0);
+    CHECK(lub_film_meniscus(&f, &e) == 1);
+    CHECK(e.inlet == 10.0 && e.outlet == 5.0 && e.contact == 10.0);
     lub_film_free(&f);
 
     /* a film with no wall: a drop column from y = 5 to 7, bottom and surface free */
@@ -393,12 +397,182 @@ static void test_film(void)
     lub_film_sample(&f, &Q);
     CHECK(lub_film_row_at(&f, 0, &r) == 1);
     CHECK(r.bottom == 5.0 && r.surface == 7.0 && r.h == 2.0 && r.contact == 0);
+    CHECK(r.full == 0 && r.filled == 0.0);  /* no wall above: no gap to fill */
     CHECK(lub_film_row_at(&f, 1, &r) == 0); /* no fluid */
-    CHECK(lub_film_meniscus(&f, &in, &out) == 0);
+    CHECK(lub_film_meniscus(&f, &e) == 0);
     lub_film_free(&f);
     CHECK(lub_film_init(&f, 1.0, 0.0, 1.0) == -1);
     lub_particles_free(&Q);
     lub_particles_free(&P);
+}
+
+/* The inlet of a wedge's film between parallel walls, known by construction.  Lattice l0 = 1,
+ * columns x = i + 1/2 (i = 0 .. 69), lower wall y = 0, upper wall y = 10 (wall particles on
+ * the surfaces, a dummy row behind each), flow towards +x:
+ *
+ *   x in [0, 10)    a layer, rows 1 .. 3, far below the upper wall
+ *   x in [10, 20)   the inlet roll: the layer, an air gap (rows 4, 5 empty) and the roll,
+ *                   rows 6 .. 9, touching the upper wall: contact, but not full
+ *   x in [20, 50)   the full film, rows 1 .. 9
+ *   x in [50, 70)   past the outlet meniscus: rows 1 .. 4, detached from the upper wall
+ *
+ * so that the inlet is at 20, the outlet at 50 and the contact at 10.  The filled fraction of
+ * the gap 10 is 0.4, 0.8, 1 and 0.5 in the four parts (cells of l0 around the particles,
+ * half of each wall's cell inside the gap).  With mirror, x -> 70 - x and the flow towards -x
+ * (inlet 50, outlet 20, contact 60).  jitter > 0 moves each fluid particle by up to jitter in
+ * x and y (a deterministic sequence from seed). */
+enum { ROLL_XA = 10, ROLL_XIN = 20, ROLL_XOUT = 50, ROLL_N = 70, ROLL_H = 10 };
+
+static double roll_rand(unsigned long *s) /* uniform in [-1, 1) (xorshift64) */
+{
+    *s ^= *s << 13, *s ^= *s >> 7, *s ^= *s << 17;
+    return (double)(*s >> 11) / 4503599627370496.0 - 1.0;
+}
+
+static void roll_case(lub_particles *P, double jitter, unsigned long seed, int mirror)
+{
+    setup(P, 1.0);
+    unsigned long s = 88172645463325252UL ^ seed;
+    for (int i = 0; i < ROLL_N; i++) {
+        double x = i + 0.5, X = mirror ? ROLL_N - x : x;
+        add(P, X, 0.0, LUB_WALL, 0), add(P, X, -1.0, LUB_DUMMY, 0);
+        add(P, X, ROLL_H, LUB_WALL, 1), add(P, X, ROLL_H + 1.0, LUB_DUMMY, 1);
+        for (int r = 1; r < ROLL_H; r++) {
+            int fluid = x < ROLL_XA     ? r <= 3
+                        : x < ROLL_XIN  ? r <= 3 || r >= 6
+                        : x < ROLL_XOUT ? 1
+                                        : r <= 4;
+            if (!fluid) continue;
+            double dx = jitter * roll_rand(&s), dy = jitter * roll_rand(&s);
+            size_t k = add(P, X + dx, r + dy, LUB_FLUID, 0);
+            P->u[0][k] = mirror ? -1.0 : 1.0;
+        }
+    }
+}
+
+/* The filled fraction of bin k of a roll_case, computed independently: the part of 1e5 points
+ * in (0, 10) that lie in a cell [y - 1/2, y + 1/2] of a fluid particle of the bin's strip (in
+ * the bin, or within l0 = 1 of its centre) or in the walls' half cells [0, 1/2], [9.5, 10]. */
+static double roll_filled(const lub_particles *P, const lub_bins *b, int k)
+{
+    enum { M = 100000 };
+    static unsigned char hit[M];
+    memset(hit, 0, sizeof hit);
+    double c = lub_bins_centre(b, k), dy = (double)ROLL_H / M;
+    for (size_t i = 0; i < P->n; i++) {
+        double x = P->x[0][i], y = P->x[1][i];
+        if (P->kind[i] != LUB_FLUID || !(lub_bins_find(b, x) == k || fabs(x - c) < 1.0)) continue;
+        int m0 = (int)floor((y - 0.5) / dy) - 1, m1 = (int)ceil((y + 0.5) / dy) + 1;
+        for (int m = m0 < 0 ? 0 : m0; m < M && m <= m1; m++)
+            if (fabs((m + 0.5) * dy - y) <= 0.5) hit[m] = 1;
+    }
+    long n = 0;
+    for (int m = 0; m < M; m++) {
+        double y = (m + 0.5) * dy;
+        n += hit[m] || y <= 0.5 || y >= ROLL_H - 0.5;
+    }
+    return (double)n / M;
+}
+
+/* On the lattice with bins on the lattice's cell edges (widths 1, 2, 5, 10 from 0): the ends
+ * exactly, the filled fraction of each part exactly. */
+static void test_film_roll_lattice(void)
+{
+    static const double widths[] = {1.0, 2.0, 5.0, 10.0};
+    for (int mirror = 0; mirror < 2; mirror++) {
+        lub_particles P;
+        roll_case(&P, 0.0, 0, mirror);
+        for (size_t w = 0; w < sizeof widths / sizeof *widths; w++) {
+            lub_film f;
+            CHECK(lub_film_init(&f, 0.0, ROLL_N, widths[w]) == 0);
+            lub_film_sample(&f, &P);
+            lub_film_ends e;
+            CHECK(lub_film_meniscus(&f, &e) == 1);
+            double in = mirror ? ROLL_N - ROLL_XIN : ROLL_XIN;
+            double out = mirror ? ROLL_N - ROLL_XOUT : ROLL_XOUT;
+            double touch = mirror ? ROLL_N - ROLL_XA : ROLL_XA;
+            if (!(e.inlet == in && e.outlet == out && e.contact == touch))
+                printf("  mirror %d, bin %g: inlet %g outlet %g contact %g\n", mirror, widths[w],
+                       e.inlet, e.outlet, e.contact);
+            CHECK(e.inlet == in && e.outlet == out && e.contact == touch);
+            for (int k = 0; k < f.bins.nbins; k++) {
+                lub_film_row r;
+                CHECK(lub_film_row_at(&f, k, &r) == 1);
+                double x = mirror ? ROLL_N - r.x : r.x;
+                int part = x < ROLL_XA ? 0 : x < ROLL_XIN ? 1 : x < ROLL_XOUT ? 2 : 3;
+                static const double filled[] = {0.4, 0.8, 1.0, 0.5};
+                static const int contact[] = {0, 1, 1, 0}, full[] = {0, 0, 1, 0};
+                CHECK_NEAR(r.filled, filled[part], 1e-15);
+                CHECK(r.contact == contact[part] && r.full == full[part]);
+                CHECK(r.n == (long)widths[w] * (part == 0 ? 3 : part == 1 ? 7 : part == 2 ? 9 : 4));
+            }
+            lub_film_free(&f);
+        }
+        lub_particles_free(&P);
+    }
+}
+
+/* Jittered (fluid moved by up to 0.3 l0, as the particles of a run are) and with bins not on
+ * the lattice (from -0.37, or on the cells' centres): each end within a bin width of its
+ * place, or within l0 + DX/2 where bins are narrower than 2 l0 (their strips reach l0 from the
+ * centre); every bin whose strip lies inside one part judged as that part.  Bins of l0 and
+ * 1.5 l0 among them: such bins hold no particle of some rows (a jittered particle leaves its
+ * column's bin), which an earlier version took for air, ending the film there. */
+static void test_film_roll_jittered(void)
+{
+    static const double widths[] = {0.5, 1.0, 1.5, 2.0, 3.0, 5.0};
+    static const double froms[] = {0.0, -0.37, -0.5};
+    int nbad = 0;
+    for (int mirror = 0; mirror < 2; mirror++)
+        for (unsigned long seed = 1; seed <= 5; seed++) {
+            lub_particles P;
+            roll_case(&P, 0.3, seed, mirror);
+            for (size_t w = 0; w < sizeof widths / sizeof *widths; w++)
+                for (size_t o = 0; o < sizeof froms / sizeof *froms; o++) {
+                    double dx = widths[w], tol = fmax(dx, 1.0 + 0.5 * dx);
+                    lub_film f;
+                    CHECK(lub_film_init(&f, froms[o], ROLL_N, dx) == 0);
+                    lub_film_sample(&f, &P);
+                    lub_film_ends e;
+                    int ok = lub_film_meniscus(&f, &e) == 1;
+                    double in = mirror ? ROLL_N - ROLL_XIN : ROLL_XIN;
+                    double out = mirror ? ROLL_N - ROLL_XOUT : ROLL_XOUT;
+                    double touch = mirror ? ROLL_N - ROLL_XA : ROLL_XA;
+                    ok = ok && fabs(e.inlet - in) < tol && fabs(e.outlet - out) < tol &&
+                         fabs(e.contact - touch) < tol;
+                    /* bins whose strip (the bin, widened to 2 l0) lies inside one part */
+                    double reach = fmax(0.5 * dx, 1.0);
+                    for (int k = 0; k < f.bins.nbins; k++) {
+                        lub_film_row r;
+                        if (!lub_film_row_at(&f, k, &r)) {
+                            ok = 0;
+                            continue;
+                        }
+                        double ref = roll_filled(&P, &f.bins, k);
+                        if (!(fabs(r.filled - ref) < 1e-3)) {
+                            ok = 0;
+                            printf("  bin %g x %g: filled %.6f, point-sampled %.6f\n", dx, r.x,
+                                   r.filled, ref);
+                        }
+                        double x = mirror ? ROLL_N - r.x : r.x;
+                        for (int part = 0; part < 4; part++) {
+                            static const double a[] = {0, ROLL_XA, ROLL_XIN, ROLL_XOUT},
+                                                b[] = {ROLL_XA, ROLL_XIN, ROLL_XOUT, ROLL_N};
+                            if (x - reach < a[part] + 0.5 || x + reach > b[part] - 0.5) continue;
+                            static const int contact[] = {0, 1, 1, 0}, full[] = {0, 0, 1, 0};
+                            int good = r.contact == contact[part] && r.full == full[part];
+                            ok = ok && good;
+                        }
+                    }
+                    if (!ok && nbad++ < 5)
+                        printf("  mirror %d seed %lu bin %g from %g: inlet %g outlet %g contact "
+                               "%g\n",
+                               mirror, seed, dx, froms[o], e.inlet, e.outlet, e.contact);
+                    CHECK(ok);
+                    lub_film_free(&f);
+                }
+            lub_particles_free(&P);
+        }
 }
 
 /* ---- the helper of tests/cases/probe ------------------------------------------------- */
@@ -453,5 +627,7 @@ int main(int argc, char **argv)
     RUN(test_arc);
     RUN(test_wall_facing);
     RUN(test_film);
+    RUN(test_film_roll_lattice);
+    RUN(test_film_roll_jittered);
     return test_summary();
 }

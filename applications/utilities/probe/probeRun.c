@@ -659,13 +659,38 @@ static void run_points(job *j)
 
 /* ---- film: thickness and free surface ------------------------------------------------- */
 
+/* Sums of one end of the film over the times (mean, range). */
+typedef struct {
+    double sum, min, max;
+} film_end;
+
+static void film_end_add(film_end *e, double x, size_t before)
+{
+    if (!before) e->min = e->max = x;
+    e->sum += x;
+    e->min = fmin(e->min, x);
+    e->max = fmax(e->max, x);
+}
+
+/* "# NAME x = MEAN [X = ..] (the times, the range)" */
+static void film_end_comment(job *j, const char *name, const film_end *e, size_t n, size_t nt)
+{
+    double x = e->sum / (double)n;
+    char X[48] = "", of[160] = "";
+    if (j->sc) snprintf(X, sizeof X, " X = %.6g", x / j->sc->sx);
+    if (nt > 1)
+        snprintf(of, sizeof of, " (mean of the %zu of %zu times with a full film; %.9g to %.9g)", n,
+                 nt, e->min, e->max);
+    probe_block_comment(&j->b, "%s x = %.9g%s%s", name, x, X, of);
+}
+
 static void run_film(job *j)
 {
     const probe_spec *s = j->s;
     lub_film film = {0};
     lub_accum acc = {0};
-    enum { H, SURFACE, BOTTOM, CONTACT, N, NCOLS };
-    double men_in = 0.0, men_out = 0.0;
+    enum { H, SURFACE, BOTTOM, CONTACT, N, FILLED, FULL, NCOLS };
+    film_end in = {0}, out = {0}, touch = {0};
     size_t nmen = 0, ntimes = 0;
     for (size_t it = 0; it < j->nt; it++) {
         job_read(j, it);
@@ -682,59 +707,57 @@ static void run_film(job *j)
         size_t found = 0;
         for (int k = 0; k < film.bins.nbins; k++) {
             if (!lub_film_row_at(&film, k, &r)) continue;
-            double v[NCOLS] = {r.h, r.surface, r.bottom, (double)r.contact, (double)r.n};
+            double v[NCOLS] = {r.h,         r.surface, r.bottom,      (double)r.contact,
+                               (double)r.n, r.filled,  (double)r.full};
             lub_accum_add(&acc, k, v);
             found++;
         }
         if (!found)
             lub_warning("time %s: no fluid particle in [%g, %g]", j->times[it].name, film.bins.from,
                         film.bins.to);
-        double a, b;
-        if (lub_film_meniscus(&film, &a, &b)) men_in += a, men_out += b, nmen++;
+        lub_film_ends e;
+        if (lub_film_meniscus(&film, &e)) {
+            film_end_add(&in, e.inlet, nmen);
+            film_end_add(&out, e.outlet, nmen);
+            film_end_add(&touch, e.contact, nmen);
+            nmen++;
+        }
         ntimes++;
         if (s->average && it != j->nt - 1) continue;
 
         char h[256] = "x[m] h[m] surface[m] bottom[m] contact n";
         if (j->sc) header_add(h, sizeof h, "X H");
-        probe_block_begin(&j->b, h, 6 + (j->sc ? 2 : 0));
+        header_add(h, sizeof h, "filled full");
+        probe_block_begin(&j->b, h, 8 + (j->sc ? 2 : 0));
         for (int k = 0; k < film.bins.nbins; k++) {
             if (acc.count[k] == 0.0) continue;
-            double xc = lub_bins_centre(&film.bins, k);
-            double row[8] = {xc,
-                             lub_accum_mean(&acc, k, H),
-                             lub_accum_mean(&acc, k, SURFACE),
-                             lub_accum_mean(&acc, k, BOTTOM),
-                             lub_accum_mean(&acc, k, CONTACT),
-                             acc.sum[(size_t)k * NCOLS + N],
-                             0.0,
-                             0.0};
+            double xc = lub_bins_centre(&film.bins, k), row[10];
+            int m = 0;
+            row[m++] = xc;
+            row[m++] = lub_accum_mean(&acc, k, H);
+            row[m++] = lub_accum_mean(&acc, k, SURFACE);
+            row[m++] = lub_accum_mean(&acc, k, BOTTOM);
+            row[m++] = lub_accum_mean(&acc, k, CONTACT);
+            row[m++] = acc.sum[(size_t)k * NCOLS + N];
             if (j->sc) {
-                row[6] = xc / j->sc->sx;
-                row[7] = row[1] / j->sc->h0;
+                row[m++] = xc / j->sc->sx;
+                row[m++] = row[1] / j->sc->h0;
             }
+            row[m++] = lub_accum_mean(&acc, k, FILLED);
+            row[m++] = lub_accum_mean(&acc, k, FULL);
             probe_block_row(&j->b, row);
         }
         if (nmen) {
-            double xi = men_in / (double)nmen, xo = men_out / (double)nmen;
-            char of[96] = "";
-            if (ntimes > 1)
-                snprintf(of, sizeof of, " (mean of the %zu of %zu times with contact)", nmen,
-                         ntimes);
-            if (j->sc) {
-                probe_block_comment(&j->b, "inletMeniscus x = %.9g X = %.6g%s", xi, xi / j->sc->sx,
-                                    of);
-                probe_block_comment(&j->b, "outletMeniscus x = %.9g X = %.6g%s", xo, xo / j->sc->sx,
-                                    of);
-            } else {
-                probe_block_comment(&j->b, "inletMeniscus x = %.9g%s", xi, of);
-                probe_block_comment(&j->b, "outletMeniscus x = %.9g%s", xo, of);
-            }
+            film_end_comment(j, "inletMeniscus", &in, nmen, ntimes);
+            film_end_comment(j, "outletMeniscus", &out, nmen, ntimes);
+            film_end_comment(j, "upperWallContact", &touch, nmen, ntimes);
         } else {
-            probe_block_comment(&j->b, "inletMeniscus none (the film touches no upper wall)");
+            probe_block_comment(&j->b, "inletMeniscus none (the gap is nowhere full from wall to "
+                                       "wall)");
         }
         job_emit(j, it);
         lub_accum_clear(&acc);
-        men_in = men_out = 0.0;
+        in = out = touch = (film_end){0};
         nmen = ntimes = 0;
     }
     lub_film_free(&film);
