@@ -47,16 +47,18 @@ void lub_film_free(lub_film *f)
 }
 
 /* The bins whose strip holds a particle at x of spacing l0: its own bin and those whose
- * centre is closer than l0 (see film.h), as [*lo, *hi].  Returns 0 when there are none. */
+ * centre is closer than LUB_FILM_STRIP l0 (see film.h), as [*lo, *hi].  Returns 0 when there
+ * are none. */
 static int strip_bins(const lub_bins *b, double x, double l0, int *lo, int *hi)
 {
     int own = lub_bins_find(b, x);
     *lo = own >= 0 ? own : b->nbins;
     *hi = own;
-    double a = fmax(x - l0, b->from), c = fmin(x + l0, b->to);
+    const double reach = LUB_FILM_STRIP * l0;
+    double a = fmax(x - reach, b->from), c = fmin(x + reach, b->to);
     if (a <= c)
         for (int k = lub_bins_find(b, a), k1 = lub_bins_find(b, c); k <= k1; k++)
-            if (fabs(x - lub_bins_centre(b, k)) < l0) {
+            if (fabs(x - lub_bins_centre(b, k)) < reach) {
                 if (k < *lo) *lo = k;
                 if (k > *hi) *hi = k;
             }

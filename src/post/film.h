@@ -1,14 +1,16 @@
 /* lubkit post-processing: the oil film's shape from the particles (probe film).
  *
  * Particles are sorted into bins of x (2-D; in 3-D the bins take every z).  Each bin is
- * judged on its strip: its own particles and, where the bin is narrower than 2 l0, also
- * those within l0 of its centre (each particle with the l0 of its level).  Particle rows are
- * about l0 apart, but a strip narrower than 2 l0 holds no particle of some of them: a
+ * judged on its strip: its own particles and, where the bin is narrower than 3 l0, also
+ * those within 1.5 l0 of its centre (LUB_FILM_STRIP; each particle with the l0 of its level).
+ * Particle rows are about l0 apart, but a narrow strip holds no particle of some of them: a
  * particle of a disordered arrangement leaves its column's narrow bin, and a bin of l0 over
  * a moving lattice holds 0, 1 or 2 columns.  Such a bin shows an empty row, or no particle
- * at all, inside a full film.  In a strip of 2 l0 the nearest column lies within l0/2 of the
- * centre, so on a lattice disordered by less than l0/2 each row has a particle there and
- * consecutive heights stay less than 2 l0 apart.  In the strip of each bin (fluid particles,
+ * at all, inside a full film.  A strip of 2 l0 was not enough in a lubricating film, whose
+ * columns shift by up to l0/2 against each other: in the reduced wedge one strip of 2 l0
+ * inside the pressurised film had consecutive heights 2.3 l0 apart (a row's particles on
+ * both sides just outside it), which ended the film there; in a strip of 3 l0 two or three
+ * columns share each row and consecutive heights stay less than 2 l0 apart.  In the strip of each bin (fluid particles,
  * and the wall particles: kind wall, not dummy, which lie on the wall surface):
  *
  *   surface  y of the highest fluid particle: the free surface.  MPS imposes p = 0 on the
@@ -44,7 +46,7 @@
  * takes the longest run of full bins (most bins; on a tie the upstream one), downstream
  * being +x when the mean fluid x-velocity is >= 0, else -x: the inlet is the upstream edge
  * of its first bin, the outlet the downstream edge of its last.  Their resolution is the bin
- * width (l0 + DX/2 for bins narrower than 2 l0, whose strips reach l0), and l0/slope
+ * width (1.5 l0 + DX/2 for bins narrower than 3 l0, whose strips reach 1.5 l0), and l0/slope
  * where the wall's slope is small: particle rows are l0 apart, so a surface less than 2 l0
  * below the wall is as full as the lattice allows (in the thesis wedge, l0 = 5 um, the gap
  * fills where the cylinder is 2 l0 above the oil, 0.2 mm upstream of where a continuous
@@ -60,6 +62,8 @@
 
 /* Contact distance in l0 (see above): heights this far apart have an empty row between. */
 #define LUB_FILM_CONTACT 2.0
+/* Half-width of the strip of a narrow bin, in l0 (see above). */
+#define LUB_FILM_STRIP 1.5
 
 /* A particle of a strip (film.c). */
 typedef struct lub_film_entry lub_film_entry;

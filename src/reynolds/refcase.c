@@ -319,7 +319,7 @@ static void gap_heights(lub_refgap *G, const lub_refcase *rc)
 /* dh/dt at fixed x for walls translating with velocities vl (lower) and vu (upper): the
  * normal speeds, and each surface, at its place at time rc->t, carried along x (-U dy/dx),
  * which vanishes for walls parallel to x (the squeeze term of T-32, 12 dh/dt of
- * methods2.md (9.1); its 6 h d(U1+U2)/dx is 0 for rigid walls). */
+ * methods.md §5.1; its 6 h d(U1+U2)/dx is 0 for rigid walls). */
 static void gap_motion(lub_refgap *G, const lub_refcase *rc)
 {
     const double *vl = rc->vel[rc->wl], *vu = rc->vel[rc->wu];

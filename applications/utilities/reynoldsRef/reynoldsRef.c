@@ -5,7 +5,7 @@
  * (the dictionary's `time`, or the time folders -time / -latestTime select) moves the walls
  * by their velocities to that time, samples the gap h(x) = (upper wall height) - (lower wall
  * height) on a uniform grid between the inlet and the outlet, solves the Reynolds equation
- * (T-32, methods2.md (9.1) with the squeeze term dh/dt of the moving walls) with the chosen
+ * (T-32, methods.md §5.1 and §5.5, with the squeeze term dh/dt of the moving walls) with the chosen
  * boundary condition, writes postProcessing/reynoldsRef/<time>/p.dat (# x p h [X P H]) and
  * prints a short report.
  * With an elasticWall in models.yaml (soft EHL) the gap follows from the pressure and the
