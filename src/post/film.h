@@ -10,8 +10,9 @@
  * columns shift by up to l0/2 against each other: in the reduced wedge one strip of 2 l0
  * inside the pressurised film had consecutive heights 2.3 l0 apart (a row's particles on
  * both sides just outside it), which ended the film there; in a strip of 3 l0 two or three
- * columns share each row and consecutive heights stay less than 2 l0 apart.  In the strip of each bin (fluid particles,
- * and the wall particles: kind wall, not dummy, which lie on the wall surface):
+ * columns share each row and consecutive heights stay less than 2 l0 apart.  In the strip of
+ * each bin (fluid particles, and the wall particles: kind wall, not dummy, which lie on the
+ * wall surface):
  *
  *   surface  y of the highest fluid particle: the free surface.  MPS imposes p = 0 on the
  *            surface particles themselves (thesis 2), so the surface lies at their centres,
