@@ -63,22 +63,7 @@ static void basis(int dim, int m, const double s[3], double q[MT])
     }
 }
 
-/* Factorisation of the leading m x m block of M (symmetric, full): scaled by the total
- * weight, S = M / M_00, then P S P^T = L diag(piv) L^T with diagonal pivoting (largest
- * remaining diagonal first).  No column equilibration: the basis is already in units of l0,
- * so a direction in which the neighbours spread over much less than l0 (nearly collinear
- * points) shows up as a small pivot instead of being scaled back to one.  A receives L below
- * its diagonal and the pivots on it; perm the order.  Returns the pivot ratio
- * piv_min / piv_max (pivots do not increase), or stops at the first pivot below rcond_min
- * times the first and returns its ratio (0 when it is not positive). */
-typedef struct {
-    double A[MT][MT];
-    double dsc[MT];
-    int perm[MT];
-    int m;
-} factor_t;
-
-static double factorise(const double M[MT][MT], int m, double rcond_min, factor_t *F)
+double lub_lsq_factorise(const double M[MT][MT], int m, double rcond_min, lub_lsq_factor *F)
 {
     F->m = m;
     const double sc = 1.0 / sqrt(M[0][0]); /* M_00 = sum_j w_j > 0 */
@@ -126,8 +111,7 @@ static double factorise(const double M[MT][MT], int m, double rcond_min, factor_
     return last / first;
 }
 
-/* Solve M a = b with the factorisation (in the original, unscaled unknowns). */
-static void solve(const factor_t *F, const double b[MT], double a[MT])
+void lub_lsq_solve(const lub_lsq_factor *F, const double b[MT], double a[MT])
 {
     const int m = F->m;
     double y[MT];
@@ -193,11 +177,11 @@ lub_lsq_result lub_lsq_interpolate(const lub_lsq_options *o, const double xt[3],
     for (int order = o->order; order >= 1; order--) {
         const int m = lub_lsq_terms(dim, order);
         lub_lsq_status why = LUB_LSQ_OK;
-        factor_t F;
+        lub_lsq_factor F;
         double rc = 0.0;
         if (cnt < m)
             why = LUB_LSQ_TOO_FEW;
-        else if ((rc = factorise(M, m, rcond_min, &F)) < rcond_min)
+        else if ((rc = lub_lsq_factorise(M, m, rcond_min, &F)) < rcond_min)
             why = LUB_LSQ_SINGULAR;
         if (why != LUB_LSQ_OK) {
             if (res.status == LUB_LSQ_OK) res.status = why; /* the reason of the first failure */
@@ -207,14 +191,14 @@ lub_lsq_result lub_lsq_interpolate(const lub_lsq_options *o, const double xt[3],
         res.rcond = rc;
         for (int k = 0; k < nf; k++) {
             double a[MT], d[MT], r[MT];
-            solve(&F, B[k], a);
+            lub_lsq_solve(&F, B[k], a);
             /* one step of iterative refinement */
             for (int i = 0; i < m; i++) {
                 double s = B[k][i];
                 for (int j = 0; j < m; j++) s -= M[i][j] * a[j];
                 r[i] = s;
             }
-            solve(&F, r, d);
+            lub_lsq_solve(&F, r, d);
             for (int i = 0; i < m; i++) a[i] += d[i];
 
             value[k] = a[0];

@@ -104,6 +104,27 @@ lub_lsq_result lub_lsq_interpolate(const lub_lsq_options *o, const double xt[3],
                                    const double *const *f, double *value, double (*grad)[3],
                                    double (*hess)[6]);
 
+/* The small symmetric positive semi-definite solves of the fits (also used by the LSMPS
+ * Laplacian, mps/lsmps.h).  lub_lsq_factorise: the leading m x m block of M (symmetric,
+ * full), scaled by M_00, S = M / M_00, then P S P^T = L diag(piv) L^T with diagonal pivoting
+ * (largest remaining diagonal first).  No column equilibration: the basis is in units of l0,
+ * so a direction in which the neighbours spread over much less than l0 (nearly collinear
+ * points) shows up as a small pivot instead of being scaled back to one.  Returns the pivot
+ * ratio piv_min / piv_max (pivots do not increase), or stops at the first pivot below
+ * rcond_min times the first and returns its ratio (0 when it is not positive; M_00 must be
+ * positive).  lub_lsq_solve: M a = b with the factorisation (the original, unscaled
+ * unknowns); only after a factorisation whose ratio is at least rcond_min. */
+typedef struct {
+    double A[LUB_LSQ_MAX_TERMS][LUB_LSQ_MAX_TERMS]; /* L below the diagonal, pivots on it */
+    double dsc[LUB_LSQ_MAX_TERMS];
+    int perm[LUB_LSQ_MAX_TERMS];
+    int m;
+} lub_lsq_factor;
+double lub_lsq_factorise(const double M[LUB_LSQ_MAX_TERMS][LUB_LSQ_MAX_TERMS], int m,
+                         double rcond_min, lub_lsq_factor *F);
+void lub_lsq_solve(const lub_lsq_factor *F, const double b[LUB_LSQ_MAX_TERMS],
+                   double a[LUB_LSQ_MAX_TERMS]);
+
 /* Number of polynomial terms of order p in dim dimensions (1 + d, or 1 + d + d(d+1)/2). */
 int lub_lsq_terms(int dim, int order);
 
