@@ -32,6 +32,7 @@
 #include "models/transport.h"
 #include "mps/levels.h"
 #include "mps/mps.h"
+#include "mps/lsmps.h"
 #include "mps/operators.h"
 
 #ifndef M_PI
@@ -55,6 +56,9 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->skin = 0.0;
     c->lsmps_det_min = LUB_MPS_LSMPS_DET_MIN;
     c->reorder_interval = 1;
+    c->lap_viscosity = LUB_LAPLACIAN_STANDARD;
+    c->lap_pressure = LUB_LAPLACIAN_STANDARD;
+    c->lsmps_rcond = LUB_LSMPS_RCOND_MIN;
     c->order_rows = 0;
     c->mirror_dummies = 1;
     c->p_solver = lub_linsolver_defaults();
@@ -123,6 +127,11 @@ static void read_schemes(lub_mps_config *c, const char *path)
     c->skin = lub_dict_real_or(r, "neighbourSkin", 0.0, LUB_BETWEEN(0.0, 1.0));
     c->lsmps_det_min =
         lub_dict_real_or(r, "lsmpsDetMin", LUB_MPS_LSMPS_DET_MIN, (lub_range){0.0, 1.0, 1, 1});
+    static const char *const lap[] = {"standard", "lsmps", NULL};
+    lub_node *ls = lub_dict_map_or(r, "laplacian");
+    c->lap_viscosity = lub_dict_choice(ls, "viscosity", lap, c->lap_viscosity);
+    c->lap_pressure = lub_dict_choice(ls, "pressure", lap, c->lap_pressure);
+    c->lsmps_rcond = lub_dict_real_or(ls, "lsmpsRcond", c->lsmps_rcond, LUB_BETWEEN(1e-12, 0.5));
     static const char *const order[] = {"cells", "rows", NULL};
     c->order_rows = lub_dict_choice(r, "particleOrder", order, c->order_rows);
     c->reorder_interval =

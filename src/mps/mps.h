@@ -46,6 +46,7 @@
 #include <stdint.h>
 
 #include "core/timer.h"
+#include "linalg/bicgstab.h"
 #include "linalg/linsolve.h"
 #include "mps/levels.h"
 #include "mps/neighbours.h"
@@ -55,6 +56,7 @@ enum { LUB_GRADIENT_STANDARD = 0, LUB_GRADIENT_LSMPS = 1 };
 enum { LUB_VISCOSITY_NONE = 0, LUB_VISCOSITY_EXPLICIT = 1, LUB_VISCOSITY_CN = 2 };
 enum { LUB_NEGATIVE_KEEP = 0, LUB_NEGATIVE_CLIP = 1, LUB_NEGATIVE_CAVITATION = 2 };
 enum { LUB_SURFACE_SECTOR = 0, LUB_SURFACE_CENTROID = 1, LUB_SURFACE_PND = 2 };
+enum { LUB_LAPLACIAN_STANDARD = 0, LUB_LAPLACIAN_LSMPS = 1 };
 
 typedef struct {
     /* system/schemes.yaml */
@@ -73,6 +75,9 @@ typedef struct {
     double cone_cos;        /* sector test: cosine of half the opening of the empty sector */
     double skin;            /* neighbour search radius re (1 + skin) */
     double lsmps_det_min;   /* LSMPS fallback threshold */
+    int lap_viscosity;      /* LUB_LAPLACIAN_*: the Laplacian of the viscous term */
+    int lap_pressure;       /* LUB_LAPLACIAN_*: the Laplacian of the pressure equation */
+    double lsmps_rcond;     /* LSMPS Laplacian: smallest pivot ratio of M_i (mps/lsmps.h) */
     int reorder_interval;   /* steps between sorts of the particles (0: never) */
     int order_rows;         /* the sort: 0 cell order, 1 lattice rows of l0 */
     int mirror_dummies;     /* dummies take the no-slip ghost velocity 2 U - u_i (viscosity) */
@@ -117,6 +122,7 @@ void lub_mps_config_read(lub_mps_config *c, const char *case_dir, const lub_part
 typedef struct {
     lub_solve_result p, v[3];
     size_t nsurface, nunknowns, nfallback, nrebuild;
+    size_t nlapfallback;            /* LSMPS Laplacian rows taken as standard (lsmps.h) */
     size_t nisolated;               /* particles of groups touching no Dirichlet particle, taken as
                                        surface particles (step.c, isolated_groups) */
     unsigned long long isolated_id; /* the id of the first of them */
@@ -146,6 +152,15 @@ typedef struct {
 
     lub_neighbours nb;
     lub_csr A; /* pressure, then viscosity matrix */
+    /* the LSMPS Laplacian (laplacian.viscosity / .pressure: lsmps): its pair coefficients
+     * (lapc, the lists' capacity), the rows that fall back to T-3 (lapflag), the
+     * nonsymmetric matrix (A2; the standard one in A preconditions it) and BiCGStab */
+    double *lapc;
+    size_t lapc_cap;
+    uint8_t *lapflag;
+    lub_csr A2;
+    lub_bicgstab_work bw;
+    double *dinv;
     lub_linsolver psolver, vsolver;
 
     size_t cap;

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "mps/lsmps.h"
 #include "mps/mps.h"
 #include "mps/operators.h"
 
@@ -53,6 +54,8 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
     lub_neighbours_init(&m->nb, m->dim, m->re, c->skin, lo, hi, periodic);
     lub_neighbours_set_order(&m->nb, c->order_rows ? m->l0 : 0.0);
     lub_csr_init(&m->A);
+    lub_csr_init(&m->A2);
+    lub_bicgstab_work_init(&m->bw);
     lub_linsolver_init(&m->psolver, &c->p_solver);
     lub_linsolver_init(&m->vsolver, &c->v_solver);
 
@@ -77,6 +80,7 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
     m->x = alloc_doubles(n);
     m->surface = lub_calloc(n ? n : 1, 1);
     m->anchor = lub_calloc(n ? n : 1, 1);
+    m->lapflag = lub_calloc(n ? n : 1, 1);
     {
         const int h = (int)ceil(m->re / m->l0), hz = m->dim == 3 ? h : 0;
         m->nlattice = 0;
@@ -116,6 +120,10 @@ void lub_mps_free(lub_mps *m)
     free(m->inside);
     lub_neighbours_free(&m->nb);
     lub_csr_free(&m->A);
+    lub_csr_free(&m->A2);
+    lub_bicgstab_work_free(&m->bw);
+    free(m->lapc);
+    free(m->lapflag);
     lub_linsolver_free(&m->psolver);
     lub_linsolver_free(&m->vsolver);
 }
@@ -231,6 +239,90 @@ static void smooth_fluid(lub_mps *m, double *const f[3], double *const out[3])
     }
 }
 
+/* ---- the LSMPS Laplacian (laplacian.viscosity / .pressure: lsmps, mps/lsmps.h) ---------
+ *
+ * Its pair coefficients L_ij for the fluid particles from their fluid and wall neighbours
+ * (dummy particles carry neither a velocity of the flow nor a pressure: the wall particles'
+ * prescribed values enter the fit as Dirichlet values instead of the dummies' mirror
+ * images).  Rows whose moment matrix is ill-conditioned (m->lapflag) keep the standard T-3
+ * row.  The nonsymmetric system is solved by BiCGStab, preconditioned by the solver of the
+ * standard matrix of the same particles (its AMG, IC(0), Jacobi or CHOLMOD factor), which
+ * lies spectrally close to it. */
+static void lsmps_coefficients(lub_mps *m)
+{
+    const lub_particles *P = m->P;
+    if (m->lapc_cap < m->nb.cap_pairs) { /* the lists grew (rare after the first steps) */
+        free(m->lapc);
+        m->lapc_cap = m->nb.cap_pairs;
+        m->lapc = lub_malloc(m->lapc_cap * sizeof *m->lapc);
+    }
+    lub_mps_mask lm = {P->kind, K_FLUID, K_FLUID | K_WALL};
+    lub_mps_lsmps_laplacian(&m->nb, &lm, m->dim, m->l0, m->c.lsmps_rcond, m->lapc, m->lapflag);
+    /* near a free surface (PND of all neighbours, dummies included, below beta n0) the fit
+     * extrapolates from a one-sided neighbourhood: its second derivatives are poor and the
+     * operator can lose the sign of a diffusion (it blew up within 15 steps at the outlet of
+     * the reduced wedge).  There, and wherever the diagonal sum_j L_ij is not positive, the
+     * standard row (stabilized LSMPS also keeps the conventional scheme at the surface,
+     * methods.md §1) */
+    const lub_neighbours *nb = &m->nb;
+    const double lim = m->c.beta * m->n0;
+    size_t nflag = 0;
+#pragma omp parallel for schedule(static) reduction(+ : nflag)
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->kind[i] != LUB_FLUID) continue;
+        if (!m->lapflag[i]) {
+            double wsum = 0, asum = 0;
+            for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+                wsum += nb->w[q];
+                if (nb->w[q] > 0 && P->kind[nb->j[q]] != LUB_DUMMY) asum += m->lapc[q];
+            }
+            if (wsum < lim || !(asum > 0)) m->lapflag[i] = 1;
+        }
+        nflag += m->lapflag[i];
+    }
+    m->st.nlapfallback += nflag;
+}
+
+typedef struct {
+    lub_linsolver *s;
+    const lub_csr *S;
+} surrogate;
+
+/* z = S^-1 r with the set-up of the solver of the standard matrix S */
+static void surrogate_apply(void *ctx, const double *r, double *z)
+{
+    surrogate *g = ctx;
+    if (g->s->o.kind == LUB_LINSOLVER_PCG) {
+        lub_pcg_precond_apply(&g->s->pcg, g->S, r, z);
+    } else {
+        lub_solve_result res;
+        const double *b[1] = {r};
+        double *x[1] = {z};
+        lub_linsolver_solve(g->s, g->S, 1, b, x, &res);
+    }
+}
+
+/* Solve A2 x_k = b_k (k < nrhs) by BiCGStab preconditioned with the solver s set up on the
+ * standard matrix A; res[k] per right-hand side; returns the worst status. */
+static lub_solve_status lsmps_solve(lub_mps *m, lub_linsolver *s, int nrhs, double *const *b,
+                                    double *const *x, lub_solve_result *res)
+{
+    lub_solve_result sr;
+    lub_solve_status worst = lub_linsolver_setup(s, &m->A, &sr);
+    if (worst != LUB_SOLVE_OK) {
+        for (int k = 0; k < nrhs; k++) res[k] = sr;
+        return worst;
+    }
+    surrogate g = {s, &m->A};
+    for (int k = 0; k < nrhs; k++) {
+        lub_solve_status st = lub_bicgstab_solve(
+            &m->bw, &m->A2, b[k], x[k], surrogate_apply, &g, s->o.pcg.tolerance, s->o.pcg.max_iter,
+            s->o.kind == LUB_LINSOLVER_PCG ? s->o.pcg.warm_start : 1, &res[k]);
+        if (st != LUB_SOLVE_OK && worst == LUB_SOLVE_OK) worst = st;
+    }
+    return worst;
+}
+
 static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
 {
     lub_particles *P = m->P;
@@ -313,7 +405,55 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
         lub_csr_finish(&m->A);
         const double *b[3] = {m->bv[0], m->bv[1], m->bv[2]};
         double *x[3] = {m->xv[0], m->xv[1], m->xv[2]};
-        lub_solve_status s = lub_linsolver_solve(&m->vsolver, &m->A, dim, b, x, m->st.v);
+        lub_solve_status s;
+        if (m->c.lap_viscosity == LUB_LAPLACIAN_LSMPS) {
+            /* (T-31) with the LSMPS Laplacian: u*_i - h sum_j L_ij (u*_j - u*_i) = u_i +
+             * h sum_j L_ij (u_j - u_i) + dt (g - G/rho), h = dt nu / 2, the wall particles'
+             * velocities known; the rows of flagged particles keep T-3's (above) */
+            lsmps_coefficients(m);
+            const double h = 0.5 * dt * m->c.nu;
+            lub_csr_begin(&m->A2, nf);
+            for (int r = 0; r < nf; r++)
+                lub_csr_set_row_length(&m->A2, r, lub_csr_row_length(&m->A, r));
+            lub_csr_alloc(&m->A2);
+#pragma omp parallel for schedule(static)
+            for (int r = 0; r < nf; r++) {
+                size_t i = (size_t)m->prow[r];
+                int *col = lub_csr_row_col(&m->A2, r);
+                double *val = lub_csr_row_val(&m->A2, r);
+                const int len = lub_csr_row_length(&m->A, r);
+                if (m->lapflag[i]) { /* the standard row and right-hand side */
+                    memcpy(col, lub_csr_row_col(&m->A, r), (size_t)len * sizeof *col);
+                    memcpy(val, lub_csr_row_val(&m->A, r), (size_t)len * sizeof *val);
+                    continue;
+                }
+                double asum = 0, rhs[3] = {0, 0, 0};
+                int e = 0;
+                for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+                    const size_t j = nb->j[q];
+                    if (nb->w[q] <= 0) continue;
+                    const double a = P->kind[j] == LUB_DUMMY ? 0.0 : m->lapc[q];
+                    asum += a;
+                    for (int d = 0; d < dim; d++) rhs[d] += a * (P->u[d][j] - P->u[d][i]);
+                    if (m->row[j] >= 0) {
+                        col[e] = m->row[j];
+                        val[e++] = -h * a;
+                    } else {
+                        for (int d = 0; d < dim; d++) rhs[d] += a * P->u[d][j];
+                    }
+                }
+                col[e] = r;
+                val[e++] = 1.0 + h * asum;
+                if (e != len) lub_bug("LSMPS viscosity row %d: %d entries, expected %d", r, e, len);
+                for (int d = 0; d < dim; d++)
+                    m->bv[d][r] =
+                        P->u[d][i] + h * rhs[d] + dt * (g[d] - (gold ? rinv * gold[d][i] : 0.0));
+            }
+            lub_csr_finish(&m->A2);
+            s = lsmps_solve(m, &m->vsolver, dim, m->bv, x, m->st.v);
+        } else {
+            s = lub_linsolver_solve(&m->vsolver, &m->A, dim, b, x, m->st.v);
+        }
         if (s != LUB_SOLVE_OK && !m->c.v_continue) {
             char d[256];
             for (int c = 0; c < dim; c++)
@@ -611,13 +751,60 @@ assemble:
             goto assemble;
         }
     }
+    const int lsmps = m->c.lap_pressure == LUB_LAPLACIAN_LSMPS;
+    if (lsmps && nu > 0) {
+        /* the LSMPS Laplacian in the fluid rows: sum_j L_ij (P_i - P_j) + alpha P_i = b_i, the
+         * Dirichlet neighbours' given pressures moved to b; the wall particles' rows (and the
+         * flagged fluid rows) stay those of T-10 above, which A keeps for the preconditioner */
+        lsmps_coefficients(m);
+        lub_csr_begin(&m->A2, nu);
+        for (int r = 0; r < nu; r++)
+            lub_csr_set_row_length(&m->A2, r, lub_csr_row_length(&m->A, r));
+        lub_csr_alloc(&m->A2);
+#pragma omp parallel for schedule(static)
+        for (int r = 0; r < nu; r++) {
+            size_t i = (size_t)m->prow[r];
+            int *col = lub_csr_row_col(&m->A2, r);
+            double *val = lub_csr_row_val(&m->A2, r);
+            const int len = lub_csr_row_length(&m->A, r);
+            if (P->kind[i] != LUB_FLUID || m->lapflag[i]) {
+                memcpy(col, lub_csr_row_col(&m->A, r), (size_t)len * sizeof *col);
+                memcpy(val, lub_csr_row_val(&m->A, r), (size_t)len * sizeof *val);
+                continue;
+            }
+            double asum = 0, bfix = 0;
+            int e = 0;
+            for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+                const size_t j = nb->j[q];
+                if (nb->w[q] <= 0 || P->kind[j] == LUB_DUMMY) continue;
+                const double a = m->lapc[q];
+                asum += a;
+                if (m->row[j] >= 0) {
+                    col[e] = m->row[j];
+                    val[e++] = -a;
+                } else if (fix && fix[j]) {
+                    bfix += a * P->p[j];
+                }
+            }
+            col[e] = r;
+            val[e++] = asum + alpha;
+            if (e != len) lub_bug("LSMPS pressure row %d: %d entries, expected %d", r, e, len);
+            m->b[r] = src * (m->pnd[i] - m->n0) + bfix;
+        }
+        lub_csr_finish(&m->A2);
+    }
     lub_timer_stop(&m->tm, LUB_T_ASSEMBLY);
 
     lub_timer_start(&m->tm, LUB_T_PSOLVE);
     const double *b = m->b;
     double *x = m->x;
-    lub_solve_status s =
-        nu > 0 ? lub_linsolver_solve(&m->psolver, &m->A, 1, &b, &x, &m->st.p) : LUB_SOLVE_OK;
+    lub_solve_status s = LUB_SOLVE_OK;
+    if (nu > 0 && lsmps) {
+        double *bb = m->b;
+        s = lsmps_solve(m, &m->psolver, 1, &bb, &x, &m->st.p);
+    } else if (nu > 0) {
+        s = lub_linsolver_solve(&m->psolver, &m->A, 1, &b, &x, &m->st.p);
+    }
     lub_timer_stop(&m->tm, LUB_T_PSOLVE);
     if (s != LUB_SOLVE_OK && !m->c.p_continue) {
         char d[256];
@@ -653,9 +840,11 @@ assemble:
                 continue;
             }
             double f = src * (m->pnd[i] - m->n0);
+            const int lrow = lsmps && P->kind[i] == LUB_FLUID && !m->lapflag[i];
             for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
                 size_t j = nb->j[q];
-                if (nb->w[q] > 0 && P->kind[j] != LUB_DUMMY) f += c * nb->w[q] * P->p[j];
+                if (nb->w[q] > 0 && P->kind[j] != LUB_DUMMY)
+                    f += (lrow ? m->lapc[q] : c * nb->w[q]) * P->p[j];
             }
             if (f > 0) cav[i] = 0;
         }
