@@ -59,8 +59,6 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->v_solver.pcg.precond = LUB_PRECOND_JACOBI;
     c->v_solver.pcg.warm_start = 1;
     c->viscosity = LUB_VISCOSITY_NONE;
-    c->collision_distance = 0.8;
-    c->restitution = 0.2;
 }
 
 static void read_linsolver(lub_node *map, lub_linsolver_options *o, int *cont)
@@ -158,31 +156,9 @@ static void read_models(lub_mps_config *c, const char *path, const char *geometr
     lub_node *r = d ? lub_dict_root(d) : NULL;
     if (r) lub_models_declare(r);
 
-    lub_node *g = lub_dict_map_or(r, "gravity");
-    c->gravity = g != NULL;
-    memset(c->g, 0, sizeof c->g);
-    if (g) lub_dict_vec(g, "g", c->g, P->dim, P->dim, LUB_ANY);
-
-    /* movingWalls names patches of the particle file: present them as walls */
-    lub_geometry geo = {0};
-    lub_wall walls[LUB_MAX_PATCHES];
-    memset(walls, 0, sizeof walls);
-    geo.dim = P->dim;
-    geo.nwalls = P->npatches;
-    geo.walls = walls;
-    for (int k = 0; k < P->npatches; k++)
-        snprintf(walls[k].name, sizeof walls[k].name, "%s", P->patch_names[k]);
-    int moving[LUB_MAX_PATCHES];
-    lub_moving_walls_read(r, &geo, c->patch_velocity, moving);
-
+    /* gravity, movingWalls, collision: the models of src/models/ (models/model.h) */
     lub_node *v = lub_dict_map_or(r, "viscosity");
     c->viscosity = v ? 1 + lub_dict_choice(v, "scheme", visc, 1) : LUB_VISCOSITY_NONE;
-
-    lub_node *col = lub_dict_map_or(r, "collision");
-    c->collision = col != NULL;
-    c->collision_distance =
-        lub_dict_real_or(col, "distance", c->collision_distance, (lub_range){0.0, 1.0, 1, 0});
-    c->restitution = lub_dict_real_or(col, "restitution", c->restitution, LUB_UNIT);
 
     /* elasticWall is read by mps/elastic_wall.c (it needs the geometry) */
     /* multiResolution is read and checked by mps/levels.c against particleGenDict's levels,

@@ -14,8 +14,12 @@
  *        pressure would be undetermined; st.nisolated)
  *     7. pressure gradient                         standard (T-13, T-14) or LSMPS (T-15)
  *     8. u^{k+1} = u* - dt/rho grad p, r^{k+1} = r* + (u^{k+1} - u*) dt   (T-16, T-17)
- *     9. collision, periodic wrap, checks (non-finite values, the domain box, a fluid
- *        particle through a wall: lub_mps_check)
+ *     9. the models' corrections (collision), periodic wrap, checks (non-finite values, the
+ *        domain box, a fluid particle through a wall: lub_mps_check)
+ *
+ * Models act at named points of the step through lub_mps.hooks (src/models/model.h fills
+ * them in for the models of a scene): forces in step 2 (gravity), after the correction in
+ * step 9 (collision).  The step knows no model by name.
  *
  * Pressure predictor (schemes.yaml pressure.predictor, not in the thesis).  Without it, a
  * steady flow balances grad p / rho = nu lap(u*) with u* = u + dt grad p / rho: the viscous
@@ -79,15 +83,12 @@ typedef struct {
 
     /* constant/ */
     double rho, nu;
-    int gravity;
-    double g[3];
+    int gravity;   /* a uniform body acceleration g given with the configuration (callers */
+    double g[3];   /* without models; the models of a scene add theirs: hooks.forces) */
     int viscosity; /* LUB_VISCOSITY_* */
-    double patch_velocity[LUB_MAX_PATCHES][3];
+    double patch_velocity[LUB_MAX_PATCHES][3]; /* wall velocities (movingWalls) */
     int patch_moved[LUB_MAX_PATCHES]; /* 1: a model sets the velocity of the patch's wall and
                                          dummy particles before each step (elasticWall) */
-    int collision;
-    double collision_distance; /* in l0 */
-    double restitution;
 
     /* set by the multi-resolution driver (mps/opt.h), not read from a dictionary */
     int fixed_flags; /* allocate lub_mps.fixed: particles whose velocity and pressure are given */
@@ -132,8 +133,23 @@ enum {
 };
 extern const char *const lub_mps_phase_names[]; /* neighbourSearch, viscositySolve, ... */
 
+typedef struct lub_mps lub_mps;
+
+/* What the models do inside the step (methods.md §2), at its named points; ctx is passed
+ * back.  Each may be NULL. */
 typedef struct {
+    void *ctx;
+    /* step 2, viscosity and body force: add the step's uniform body acceleration [m/s^2] to
+     * acc (it holds the configuration's g); returns 1 if it added one */
+    int (*forces)(void *ctx, const lub_mps *m, double dt, double acc[3]);
+    /* step 9, after the correction (u^{k+1}, r^{k+1}) and before the periodic wrap and the
+     * checks: a change of the fluid particles' velocities and positions (collision) */
+    void (*after_correction)(void *ctx, lub_mps *m, double dt);
+} lub_mps_hooks;
+
+struct lub_mps {
     lub_mps_config c;
+    lub_mps_hooks hooks; /* zero: no model acts in the step */
     lub_particles *P;
     int dim;
     double l0, re, n0, lambda0;
@@ -177,7 +193,7 @@ typedef struct {
 
     lub_mps_stats st;
     lub_timers tm;
-} lub_mps;
+};
 
 /* Set up the solver for particles P (the state lives in P; its capacity must not change
  * while the solver runs: the work arrays are allocated for P->cap particles, so P->n may grow
@@ -228,6 +244,11 @@ static inline void lub_mps_rebuild_lists(lub_mps *m)
 {
     m->built = 0;
 }
+
+/* Build the neighbour lists afresh now, at the current positions (a model that moved the
+ * particles within the step and needs every pair: the collision model); timed as the
+ * neighbour search. */
+void lub_mps_relist(lub_mps *m);
 
 /* Largest speed of all particles (fluid and moving walls). */
 double lub_mps_max_speed(const lub_mps *m);

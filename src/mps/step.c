@@ -163,6 +163,11 @@ static void neighbours(lub_mps *m, int rebuild)
     lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
 }
 
+void lub_mps_relist(lub_mps *m)
+{
+    neighbours(m, 1);
+}
+
 /* Pass 1 of the CSR assembly of an MPS matrix over the unknowns prow[0..nrows): row r has
  * the diagonal and one entry per neighbour j with w_ij > 0 that is itself an unknown. */
 static void begin_rows(lub_mps *m, int nrows)
@@ -227,12 +232,12 @@ static void smooth_fluid(lub_mps *m, double *const f[3], double *const out[3])
     }
 }
 
-static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
+/* g: the body acceleration of the step, body: whether there is one (lub_mps_step) */
+static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg, size_t msgsize)
 {
     lub_particles *P = m->P;
     const size_t n = P->n;
     const int dim = m->dim;
-    const double *g = m->c.g;
     /* a fixed-band particle (m->fixed) keeps its given velocity: u* = u, a Dirichlet value */
     const uint8_t *fix = m->fixed;
     lub_timer_start(&m->tm, LUB_T_VISCOSITY);
@@ -324,7 +329,7 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
         for (int d = 0; d < dim; d++)
 #pragma omp parallel for schedule(static)
             for (int r = 0; r < nf; r++) m->us[d][m->prow[r]] = m->xv[d][r];
-    } else if (m->c.gravity || rinv != 0.0) {
+    } else if (body || rinv != 0.0) {
         for (int d = 0; d < dim; d++)
 #pragma omp parallel for schedule(static)
             for (size_t i = 0; i < n; i++)
@@ -579,52 +584,6 @@ assemble:
         }
     }
     return 0;
-}
-
-/* Collision (methods.md §2 step 7): a fluid particle closer than the collision distance to
- * another particle and approaching it loses the approaching part of the relative normal
- * velocity, with restitution e: half of (1 + e) of it against a fluid particle (equal
- * masses), all of it against a wall or dummy particle (infinite mass).  Each particle's
- * change is computed from the velocities before the collision step, so the result does not
- * depend on the order or the number of threads.  The pairs are those of the lists at r*
- * (lub_mps_step checks that they are complete), at the current positions. */
-static void collision(lub_mps *m, double dt)
-{
-    lub_particles *P = m->P;
-    const lub_neighbours *nb = &m->nb;
-    const size_t n = P->n;
-    const double dc = m->c.collision_distance * m->l0, e = m->c.restitution;
-    double *du[3] = {m->grad[0], m->grad[1], m->grad[2]};
-    double *x[3] = {P->x[0], P->x[1], P->x[2]};
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
-        double acc[3] = {0, 0, 0};
-        /* a fixed-band particle keeps its given velocity (it still stops the others) */
-        if (P->kind[i] == LUB_FLUID && !(m->fixed && m->fixed[i])) {
-            for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
-                const size_t j = nb->j[q];
-                double v[3];
-                const double r2 = lub_neighbours_r(nb, x, i, j, v); /* now, not at the build */
-                if (r2 >= dc * dc || r2 <= 0) continue;
-                const double r = sqrt(r2);
-                double vn = 0, ev[3] = {0, 0, 0};
-                for (int d = 0; d < m->dim; d++) {
-                    ev[d] = v[d] / r;
-                    vn += (P->u[d][i] - P->u[d][j]) * ev[d];
-                }
-                if (vn <= 0) continue; /* separating */
-                double f = P->kind[j] == LUB_FLUID ? 0.5 * (1 + e) : (1 + e);
-                for (int d = 0; d < m->dim; d++) acc[d] -= f * vn * ev[d];
-            }
-        }
-        for (int d = 0; d < 3; d++) du[d][i] = acc[d];
-    }
-    for (int d = 0; d < m->dim; d++)
-#pragma omp parallel for schedule(static)
-        for (size_t i = 0; i < n; i++) {
-            P->u[d][i] += du[d][i];
-            P->x[d][i] += du[d][i] * dt;
-        }
 }
 
 /* Wrap periodic coordinates into [lo, hi). */
@@ -983,8 +942,11 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
             for (int d = 0; d < dim; d++) P->u[d][i] = m->c.patch_velocity[P->patch[i]][d];
     neighbours(m, rebuild);
 
-    /* 2. viscosity and body force */
-    if (viscosity(m, dt, msg, msgsize)) return LUB_STEP_SOLVE_FAILED;
+    /* 2. viscosity and body force (the configuration's g and the models': gravity) */
+    double g[3] = {m->c.g[0], m->c.g[1], m->c.g[2]};
+    int body = m->c.gravity;
+    if (m->hooks.forces && m->hooks.forces(m->hooks.ctx, m, dt, g)) body = 1;
+    if (viscosity(m, dt, g, body, msg, msgsize)) return LUB_STEP_SOLVE_FAILED;
 
     /* 3. temporary positions (T-8); with still_walls only the fluid moves (the walls are at
      * rest or slide along themselves: their particles carry the velocity in place), and the
@@ -1045,20 +1007,8 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     }
     lub_timer_stop(&m->tm, LUB_T_GRADIENT);
 
-    /* 9. collision, periodic wrap, checks */
-    if (m->c.collision) {
-        /* the lists of r* hold every pair now closer than the collision distance while no
-         * particle moved (r* to now: the correction) more than half their difference */
-        lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
-        double *x[3] = {P->x[0], P->x[1], P->x[2]};
-        const double lim = 0.5 * (m->re - m->c.collision_distance * m->l0);
-        const int rebuild = lub_neighbours_moved(&m->nb, x, lim) != 0;
-        lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
-        if (rebuild) neighbours(m, 1);
-        lub_timer_start(&m->tm, LUB_T_OTHER);
-        collision(m, dt);
-        lub_timer_stop(&m->tm, LUB_T_OTHER);
-    }
+    /* 9. the models' corrections (collision), periodic wrap, checks */
+    if (m->hooks.after_correction) m->hooks.after_correction(m->hooks.ctx, m, dt);
     lub_timer_start(&m->tm, LUB_T_OTHER);
     wrap(m);
     lub_step_status s = lub_mps_check(m, dt, bad, msg, msgsize);

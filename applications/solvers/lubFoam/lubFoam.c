@@ -183,31 +183,13 @@ static void print_header(const lubfoam_run *r, double average, int others_runnin
     lub_message("Solvers: p %s; U %s", ps, vs);
     /* the models of constant/models.yaml this run has (a scene enables only those it needs) */
     char models[1024];
-    size_t len = 0;
+    lub_scene_describe(&r->scene, models, sizeof models);
+    size_t len = strlen(models);
 #define LUB_MODELS_ADD(...)                                                                        \
     do {                                                                                           \
         if (len < sizeof models)                                                                   \
             len += (size_t)snprintf(models + len, sizeof models - len, __VA_ARGS__);               \
     } while (0)
-    models[0] = '\0';
-    if (m->c.gravity) {
-        LUB_MODELS_ADD("gravity (%g", m->c.g[0]);
-        for (int d = 1; d < m->dim; d++) LUB_MODELS_ADD(", %g", m->c.g[d]);
-        LUB_MODELS_ADD(") m/s^2");
-    }
-    int moving = 0;
-    for (int k = 0; k < m->P->npatches && k < LUB_MAX_PATCHES; k++) {
-        const double *v = m->c.patch_velocity[k];
-        if (v[0] == 0 && v[1] == 0 && v[2] == 0) continue;
-        LUB_MODELS_ADD("%s%s", len ? (moving ? ", " : "; ") : "", moving ? "" : "movingWalls ");
-        LUB_MODELS_ADD("%s (%g", m->P->patch_names[k], v[0]);
-        for (int d = 1; d < m->dim; d++) LUB_MODELS_ADD(", %g", v[d]);
-        LUB_MODELS_ADD(") m/s");
-        moving++;
-    }
-    if (m->c.collision)
-        LUB_MODELS_ADD("%scollision (distance %g l0, restitution %g)", len ? "; " : "",
-                       m->c.collision_distance, m->c.restitution);
     if (r->has_elastic) LUB_MODELS_ADD("%selasticWall", len ? "; " : "");
     if (r->opt) LUB_MODELS_ADD("%smultiResolution", len ? "; " : "");
 #undef LUB_MODELS_ADD
@@ -418,11 +400,15 @@ int main(int argc, char **argv)
     lub_mps_config cfg;
     lub_levels levels;
     lub_mps_config_read(&cfg, r.cs.root, &r.P, &levels);
+    lub_scene_read(&r.scene, lub_case_path(&r.cs, path, "constant/models.yaml"), &r.P, &geo, &cfg);
     if (levels.nlevels > 0) {
         /* multi-resolution: one solver per level (mps/opt.h); r.P keeps all levels, merged
          * back after every step for the function objects and the time folders */
         r.opt = lub_malloc(sizeof *r.opt);
         lub_opt_init(r.opt, &levels, &r.P, &cfg, &geo, 0.5);
+        lub_mps *lv[LUB_MAX_LEVELS];
+        for (int k = 0; k < r.opt->nlevels; k++) lv[k] = &r.opt->m[k];
+        lub_scene_attach(&r.scene, lv, r.opt->nlevels);
         lubfoam_read_elastic(&r, &geo);
         if (r.has_elastic) lub_opt_moving_wall(r.opt, &geo, r.elastic.patch);
         lub_particles_reserve(&r.P, lub_opt_capacity(r.opt));
@@ -437,6 +423,8 @@ int main(int argc, char **argv)
         lub_opt_set_mass0(r.opt, r.mass0);
     } else {
         lub_mps_init(&r.mps, &r.P, &cfg, geo.dmin, geo.dmax, geo.periodic);
+        lub_mps *lv = &r.mps;
+        lub_scene_attach(&r.scene, &lv, 1);
         lubfoam_read_elastic(&r, &geo);
     }
     lubfoam_functions *fos = lubfoam_functions_read(&r);
@@ -609,6 +597,7 @@ int main(int argc, char **argv)
     } else {
         lub_mps_free(&r.mps);
     }
+    lub_scene_free(&r.scene);
     lub_particles_free(&r.P);
     lub_control_free(&r.ctl);
     free(r.written);

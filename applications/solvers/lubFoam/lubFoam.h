@@ -7,6 +7,7 @@
 #include "geometry/geometry.h"
 #include "io/case.h"
 #include "io/control.h"
+#include "models/model.h"
 #include "mps/elastic_wall.h"
 #include "mps/mps.h"
 #include "mps/opt.h"
@@ -19,6 +20,7 @@ typedef struct {
     lub_opt *opt;      /* multi-resolution (constant/models.yaml multiResolution): the levels and
                           their solvers (mps/opt.h), else NULL; mps is then unused */
     lub_particles P;   /* the particles (multi-resolution: all levels, merged after every step) */
+    lub_scene scene;   /* the models of constant/models.yaml */
     double mass0;      /* multi-resolution: the fluid mass M^0 of the run's first start (T-27) */
     int has_opt_state; /* the start folder's uniform/state.yaml has multiResolution: */
     unsigned long long next_id; /*   the next particle id, */
