@@ -16,8 +16,24 @@
  *               combinations with other models (a misspelt key is reported first)
  *   configure   its part of the fluid's configuration (the walls' velocities: movingWalls),
  *               before the solvers are built
- *   forces      step 2 of every level's step: add a uniform body acceleration (gravity)
+ *   init        after the solvers (s->level): its fields in the particles (saved in the
+ *               time folders), its restart state (s->state_path), checks against endTime
+ *   header      its lines of the log's header (after describe's "Models:" line)
+ *   functions_start    its tables under postProcessing/ (a run with a step to take)
+ *
+ * and at every step (methods.md §2), from time t to t + dt:
+ *
+ *   before_step        before the step of every level (elasticWall: the wall's motion); a
+ *                      failure stops the run with the state before the step kept
+ *   forces             step 2 of every level's step: add a uniform body acceleration
  *   after_correction   step 9, after the velocity and position correction: collision
+ *   after_step         after every level's step, the time now t + dt (elasticWall: the
+ *                      running mean of the wall pressure)
+ *   functions_execute  its tables, after after_step
+ *   log                its part of the log line
+ *
+ * and write_state (its entry in the time folders' uniform/state.yaml, for an exact restart),
+ * summary (its lines at the end of the run), free.
  *
  * Adding a model: a folder src/models/<name>/ with <name>.c defining
  * `const lub_model_type lub_model_<name>`, and the line LUB_MODEL(<name>) in registry.h.
@@ -29,6 +45,7 @@
 #include <stdio.h>
 
 #include "geometry/geometry.h"
+#include "io/case.h"
 #include "io/dict.h"
 #include "mps/mps.h"
 #include "particles/particles.h"
@@ -45,13 +62,24 @@ typedef struct lub_model_type {
     void (*read)(lub_model *m, lub_scene *s);
     void (*check)(lub_model *m, lub_scene *s);
     void (*configure)(lub_model *m, lub_scene *s, lub_mps_config *c);
+    void (*init)(lub_model *m, lub_scene *s);
     /* its entry in the "Models:" line of the log's header */
     void (*describe)(const lub_model *m, const lub_scene *s, char *buf, size_t size);
+    void (*header)(const lub_model *m, const lub_scene *s);
+    /* start: the name of the start time folder (postProcessing/<name>/<start>/) */
+    void (*functions_start)(lub_model *m, lub_scene *s, const char *start, double t);
 
+    lub_step_status (*before_step)(lub_model *m, lub_scene *s, double t, double dt, char *msg,
+                                   size_t msgsize);
     /* inside the step of each level's solver f (mps.h lub_mps_hooks) */
     int (*forces)(lub_model *m, const lub_mps *f, double dt, double acc[3]);
     void (*after_correction)(lub_model *m, lub_mps *f, double dt);
+    void (*after_step)(lub_model *m, lub_scene *s, double t);
+    void (*functions_execute)(lub_model *m, lub_scene *s, double t, long step);
+    void (*log)(const lub_model *m, const lub_scene *s, char *buf, size_t size);
 
+    void (*write_state)(const lub_model *m, const lub_scene *s, FILE *fp);
+    void (*summary)(const lub_model *m, const lub_scene *s, double t);
     void (*free)(lub_model *m);
 } lub_model_type;
 
@@ -61,13 +89,25 @@ struct lub_model {
     void *state;     /* type->size bytes */
 };
 
+struct lub_levels;
+
 /* The models of a run. */
 struct lub_scene {
-    lub_particles *P;        /* the particles (every level) */
-    const lub_geometry *geo; /* the geometry (system/particleGenDict.yaml); set-up only */
-    lub_dict *dict;          /* constant/models.yaml (NULL: none) */
+    const lub_case *cs;             /* the case */
+    lub_particles *P;               /* the particles (every level) */
+    const lub_geometry *geo;        /* the geometry (system/particleGenDict.yaml); set-up only */
+    char models_path[LUB_PATH_MAX]; /* constant/models.yaml */
+    lub_dict *dict;                 /* constant/models.yaml (NULL: none) */
     int nmodels;
     lub_model model[LUB_MAX_MODELS]; /* in the order of the registry */
+
+    /* set by lub_scene_init */
+    int nlevels;
+    lub_mps *level[LUB_MAX_LEVELS];  /* the solver of each resolution level */
+    const struct lub_levels *levels; /* multi-resolution: the levels (NULL: one level) */
+    char state_path[LUB_PATH_MAX];   /* the start folder's uniform/state.yaml (may not exist) */
+    double end_time;                 /* > 0: the run's end time (checks against it) */
+    char end_what[128];              /* how to name it in a message */
 };
 
 /* The registry: every model type, NULL-terminated, in the order of registry.h (the order
@@ -75,15 +115,32 @@ struct lub_scene {
 extern const lub_model_type *const lub_model_types[];
 const lub_model_type *lub_model_type_find(const char *name);
 
-/* Read constant/models.yaml (models_path; a missing file lists no model) and set up the
- * models it lists: read, then check, then configure on c.  Fatal (exit 1) with file:line on
- * bad input, a misspelt model name or key included. */
-void lub_scene_read(lub_scene *s, const char *models_path, lub_particles *P,
-                    const lub_geometry *geo, lub_mps_config *c);
-/* Attach the models' in-step operations to the solvers of the levels (mps.h hooks). */
-void lub_scene_attach(lub_scene *s, lub_mps *const *levels, int nlevels);
-/* The "Models:" list of the header ("none (constant/models.yaml)" without a model). */
+/* Read the case's constant/models.yaml (a missing file lists no model) and set up the models
+ * it lists: read, then check, then configure on c.  Fatal (exit 1) with file:line on bad
+ * input, a misspelt model name or key included. */
+void lub_scene_read(lub_scene *s, const lub_case *cs, lub_particles *P, const lub_geometry *geo,
+                    lub_mps_config *c);
+/* The solvers of the levels (levels: multi-resolution, else NULL and nlevels 1) are built:
+ * attach the models' in-step operations to them (mps.h hooks) and call every model's init.
+ * state_path: the start folder's uniform/state.yaml; end_time > 0: the run's end time. */
+void lub_scene_init(lub_scene *s, lub_mps *const *level, int nlevels,
+                    const struct lub_levels *levels, const char *state_path, double end_time,
+                    const char *end_what);
+/* The "Models:" list of the header (empty without a model). */
 void lub_scene_describe(const lub_scene *s, char *buf, size_t size);
+/* Every model's header lines. */
+void lub_scene_header(const lub_scene *s);
+void lub_scene_functions_start(lub_scene *s, const char *start, double t);
+/* Before the step from t to t + dt: the first failure (msg) stops the others. */
+lub_step_status lub_scene_before_step(lub_scene *s, double t, double dt, char *msg, size_t msgsize);
+/* After the step, the time now t. */
+void lub_scene_after_step(lub_scene *s, double t);
+/* The models' tables after the step (step: the step count now). */
+void lub_scene_functions_execute(lub_scene *s, double t, long step);
+/* The models' parts of the log line, each with its leading separator. */
+void lub_scene_log(const lub_scene *s, char *buf, size_t size);
+void lub_scene_write_state(const lub_scene *s, FILE *fp);
+void lub_scene_summary(const lub_scene *s, double t);
 /* The model of that name, or NULL when the scene does not list it. */
 lub_model *lub_scene_find(const lub_scene *s, const char *name);
 void lub_scene_free(lub_scene *s);

@@ -5,11 +5,21 @@
 
 /* The keys of constant/models.yaml that are not models of the registry (models/registry.h):
  * the fluid's, and the models the solver wires in itself. */
-static const char *const other_keys[] = {"viscosity", "elasticWall", "multiResolution", NULL};
+static const char *const other_keys[] = {"viscosity", "multiResolution", NULL};
 
 void lub_models_declare(lub_node *root)
 {
     if (!root) return;
+    for (int i = 0; lub_model_types[i]; i++) lub_dict_find(root, lub_model_types[i]->name);
+    for (int i = 0; other_keys[i]; i++) lub_dict_find(root, other_keys[i]);
+}
+
+void lub_models_declare_state(lub_node *root)
+{
+    if (!root) return;
+    lub_dict_find(root, "time");
+    lub_dict_find(root, "step");
+    lub_dict_find(root, "deltaT");
     for (int i = 0; lub_model_types[i]; i++) lub_dict_find(root, lub_model_types[i]->name);
     for (int i = 0; other_keys[i]; i++) lub_dict_find(root, other_keys[i]);
 }

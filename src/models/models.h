@@ -22,6 +22,10 @@
  * mapping of models.yaml. */
 void lub_models_declare(lub_node *root);
 
+/* The same for the root of a time folder's uniform/state.yaml: the solver's entries (time,
+ * step, deltaT) and the models' (each model reads its own). */
+void lub_models_declare_state(lub_node *root);
+
 /* movingWalls: { <wallName>: { velocity: [u, v(, w)] } } (models/movingWalls/movingWalls.c).
  * Fills vel[w] (velocity of wall w of g, zero when not listed; 2-D vectors get w = 0) and
  * moving[w] (1 when listed); both sized g->nwalls.  A name that is not a wall of the geometry

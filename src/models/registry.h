@@ -5,3 +5,4 @@
 LUB_MODEL(gravity)
 LUB_MODEL(movingWalls)
 LUB_MODEL(collision)
+LUB_MODEL(elasticWall)

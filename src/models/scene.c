@@ -1,4 +1,5 @@
 /* lubkit models: a scene's models, built from constant/models.yaml (models/model.h). */
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -6,17 +7,21 @@
 #include "models/model.h"
 #include "models/models.h"
 
-void lub_scene_read(lub_scene *s, const char *models_path, lub_particles *P,
-                    const lub_geometry *geo, lub_mps_config *c)
+void lub_scene_read(lub_scene *s, const lub_case *cs, lub_particles *P, const lub_geometry *geo,
+                    lub_mps_config *c)
 {
     memset(s, 0, sizeof *s);
+    s->cs = cs;
     s->P = P;
     s->geo = geo;
-    s->dict = lub_dict_read_optional(models_path);
+    lub_case_path(cs, s->models_path, "constant/models.yaml");
+    s->dict = lub_dict_read_optional(s->models_path);
     lub_node *root = s->dict ? lub_dict_root(s->dict) : NULL;
     lub_models_declare(root);
     for (int k = 0; lub_model_types[k]; k++) {
-        lub_node *entry = lub_dict_map_or(root, lub_model_types[k]->name);
+        /* found, not looked into: a model that reads its entry elsewhere (elasticWall: from
+         * its own copy of the file) leaves it unjudged here */
+        lub_node *entry = lub_dict_find(root, lub_model_types[k]->name);
         if (!entry) continue;
         if (s->nmodels == LUB_MAX_MODELS)
             lub_bug("more than %d models: raise LUB_MAX_MODELS", LUB_MAX_MODELS);
@@ -51,7 +56,7 @@ static void scene_after_correction(void *ctx, lub_mps *f, double dt)
             s->model[k].type->after_correction(&s->model[k], f, dt);
 }
 
-void lub_scene_attach(lub_scene *s, lub_mps *const *levels, int nlevels)
+static void attach(lub_scene *s, lub_mps *const *levels, int nlevels)
 {
     int forces = 0, after = 0;
     for (int k = 0; k < s->nmodels; k++) {
@@ -64,6 +69,22 @@ void lub_scene_attach(lub_scene *s, lub_mps *const *levels, int nlevels)
         h->forces = forces ? scene_forces : NULL;
         h->after_correction = after ? scene_after_correction : NULL;
     }
+}
+
+void lub_scene_init(lub_scene *s, lub_mps *const *level, int nlevels,
+                    const struct lub_levels *levels, const char *state_path, double end_time,
+                    const char *end_what)
+{
+    if (nlevels < 1 || nlevels > LUB_MAX_LEVELS) lub_bug("lub_scene_init: %d levels", nlevels);
+    s->nlevels = nlevels;
+    for (int k = 0; k < nlevels; k++) s->level[k] = level[k];
+    s->levels = levels;
+    snprintf(s->state_path, sizeof s->state_path, "%s", state_path ? state_path : "");
+    s->end_time = end_time;
+    snprintf(s->end_what, sizeof s->end_what, "%s", end_what ? end_what : "");
+    attach(s, level, nlevels);
+    for (int k = 0; k < s->nmodels; k++)
+        if (s->model[k].type->init) s->model[k].type->init(&s->model[k], s);
 }
 
 void lub_scene_describe(const lub_scene *s, char *buf, size_t size)
@@ -80,6 +101,66 @@ void lub_scene_describe(const lub_scene *s, char *buf, size_t size)
         if (!one[0]) continue; /* nothing to say (movingWalls with every wall at rest) */
         len += (size_t)snprintf(buf + len, size - len, "%s%s", len ? "; " : "", one);
     }
+}
+
+void lub_scene_header(const lub_scene *s)
+{
+    for (int k = 0; k < s->nmodels; k++)
+        if (s->model[k].type->header) s->model[k].type->header(&s->model[k], s);
+}
+
+void lub_scene_functions_start(lub_scene *s, const char *start, double t)
+{
+    for (int k = 0; k < s->nmodels; k++)
+        if (s->model[k].type->functions_start)
+            s->model[k].type->functions_start(&s->model[k], s, start, t);
+}
+
+lub_step_status lub_scene_before_step(lub_scene *s, double t, double dt, char *msg, size_t msgsize)
+{
+    msg[0] = '\0';
+    for (int k = 0; k < s->nmodels; k++) {
+        if (!s->model[k].type->before_step) continue;
+        lub_step_status st = s->model[k].type->before_step(&s->model[k], s, t, dt, msg, msgsize);
+        if (st != LUB_STEP_OK) return st;
+    }
+    return LUB_STEP_OK;
+}
+
+void lub_scene_after_step(lub_scene *s, double t)
+{
+    for (int k = 0; k < s->nmodels; k++)
+        if (s->model[k].type->after_step) s->model[k].type->after_step(&s->model[k], s, t);
+}
+
+void lub_scene_functions_execute(lub_scene *s, double t, long step)
+{
+    for (int k = 0; k < s->nmodels; k++)
+        if (s->model[k].type->functions_execute)
+            s->model[k].type->functions_execute(&s->model[k], s, t, step);
+}
+
+void lub_scene_log(const lub_scene *s, char *buf, size_t size)
+{
+    size_t len = 0;
+    buf[0] = '\0';
+    for (int k = 0; k < s->nmodels && len < size; k++)
+        if (s->model[k].type->log) {
+            s->model[k].type->log(&s->model[k], s, buf + len, size - len);
+            len += strlen(buf + len);
+        }
+}
+
+void lub_scene_write_state(const lub_scene *s, FILE *fp)
+{
+    for (int k = 0; k < s->nmodels; k++)
+        if (s->model[k].type->write_state) s->model[k].type->write_state(&s->model[k], s, fp);
+}
+
+void lub_scene_summary(const lub_scene *s, double t)
+{
+    for (int k = 0; k < s->nmodels; k++)
+        if (s->model[k].type->summary) s->model[k].type->summary(&s->model[k], s, t);
 }
 
 lub_model *lub_scene_find(const lub_scene *s, const char *name)

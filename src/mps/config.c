@@ -124,7 +124,7 @@ static void read_solution(lub_mps_config *c, const char *path)
  * line.  Called after lub_dict_finish, so that a misspelt key is reported first. */
 static void check_supported(const lub_levels *L, lub_node *mr, lub_node *root)
 {
-    /* the elastic wall across levels (mps/elastic_wall.h) moves every level's wall each step
+    /* the elastic wall across levels (models/elasticWall/elasticWall.h) moves every level's wall each step
      * from one deformation: every level takes the same steps (T-60); it is tested on two
      * levels (tests/cases/softEHLOPT) */
     lub_node *ew = lub_dict_find(root, "elasticWall");
@@ -160,7 +160,7 @@ static void read_models(lub_mps_config *c, const char *path, const char *geometr
     lub_node *v = lub_dict_map_or(r, "viscosity");
     c->viscosity = v ? 1 + lub_dict_choice(v, "scheme", visc, 1) : LUB_VISCOSITY_NONE;
 
-    /* elasticWall is read by mps/elastic_wall.c (it needs the geometry) */
+    /* elasticWall is read by models/elasticWall/elasticWall.c (it needs the geometry) */
     /* multiResolution is read and checked by mps/levels.c against particleGenDict's levels,
      * so that a bad entry is reported with its line; a caller without L cannot run it */
     lub_node *mr = lub_dict_find(r, "multiResolution");

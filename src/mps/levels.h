@@ -109,7 +109,7 @@ typedef struct {
     double lo, hi;    /* the overlap [lo, hi], hi - lo = L */
 } lub_level_boundary;
 
-typedef struct {
+typedef struct lub_levels {
     int dim;
     int nlevels;
     lub_level_def level[LUB_MAX_LEVELS];

@@ -37,7 +37,7 @@
  * Walls are one layer of wall particles (pressure solved) with dummy layers behind them (PND
  * only).  Wall and dummy particles move with the velocity of their patch (movingWalls), or,
  * on a patch with patch_moved set, with the velocity a model gave them before the step
- * (elasticWall: mps/elastic_wall.h).
+ * (elasticWall: models/elasticWall/elasticWall.h).
  *
  * Configuration comes from system/schemes.yaml, system/solution.yaml, constant/models.yaml
  * and constant/transportProperties.yaml (lub_mps_config_read); the state is a lub_particles
@@ -211,7 +211,7 @@ typedef enum {
     LUB_STEP_NONFINITE,    /* NaN or Inf in a particle value */
     LUB_STEP_ESCAPED,      /* a particle left the domain through a non-periodic side, or a
                               fluid particle went through a wall (elasticWall: a wall would
-                              cross the plate, mps/elastic_wall.h) */
+                              cross the plate, models/elasticWall/elasticWall.h) */
 } lub_step_status;
 
 /* Advance by dt.  On failure, *bad is the index of the first offending particle (or -1) and

@@ -59,7 +59,7 @@
  * only carry their patch velocity: every wall must be at rest or a plane sliding along itself
  * (movingWalls), which is translation invariant.  Other moving walls are refused at set-up.
  * The exception is a wall that a model moves while keeping its particles' x (mps.h
- * patch_moved): the elastic wall (mps/elastic_wall.h, Multi-resolution), whose particles on
+ * patch_moved): the elastic wall (models/elasticWall/elasticWall.h, Multi-resolution), whose particles on
  * every level move vertically with the one displacement computed from the wall pressure of
  * the levels owning each x (T-62..T-67), before each step of every level (commonDeltaT:
  * the configuration refuses sub-stepping with it).  Its band particles (T-25, T-26) take

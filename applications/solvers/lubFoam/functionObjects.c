@@ -29,15 +29,8 @@
  *              averages from its start time only.
  * The cost table (postProcessing/cost/<startTime>/cost.dat) is written by lubFoam itself.
  *
- * With the elasticWall model (constant/models.yaml) a table is always written, every
- * max(1, averageSteps / 20) steps (the running mean changes on the scale of averageSteps):
- * postProcessing/elasticWall/<startTime>/elasticWall.dat
- *     # t h0 centre load loadTarget loadTargetMean beta loadInstant vMin vMax gapMin
- * h0 the rigid-body position of T-50, centre = h0 + v(x_c), load the integral of the mean
- * wall pressure (what the load balance sees), loadTarget W(t) (T-53), loadTargetMean W(t)
- * in the same running mean (what the balance compares the load with), beta = load /
- * loadTarget - 1, loadInstant the integral of the wall pressure of the step, v the elastic
- * displacement, gapMin the smallest distance of a wall particle to the surface beneath.
+ * The models' own tables (elasticWall.dat: src/models/elasticWall/io.c) are opened and
+ * written with these (lub_scene_functions_start, lub_scene_functions_execute).
  */
 #include <dirent.h>
 #include <errno.h>
@@ -69,40 +62,7 @@ typedef struct {
 struct lubfoam_functions {
     int n;
     fo *f;
-    FILE *elastic; /* elasticWall.dat */
-    long elastic_interval;
 };
-
-static void elastic_open(lubfoam_functions *F, lubfoam_run *r)
-{
-    char path[LUB_PATH_MAX];
-    lub_postproc_path(&r->cs, "elasticWall", r->start_name, "elasticWall.dat", path);
-    F->elastic = fopen(path, "w");
-    if (!F->elastic) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
-    lub_table_write_header(F->elastic, "t[s] h0[m] centre[m] load[N/m] loadTarget[N/m] "
-                                       "loadTargetMean[N/m] beta loadInstant[N/m] vMin[m] "
-                                       "vMax[m] gapMin[m]");
-    long n = r->elastic.e.average_steps / 20;
-    F->elastic_interval = n > 1 ? n : 1;
-}
-
-static void elastic_row(lubfoam_functions *F, lubfoam_run *r)
-{
-    const lub_mps_elastic *w = &r->elastic;
-    double row[11] = {r->t,
-                      w->h0,
-                      w->centre,
-                      w->load,
-                      w->load_target,
-                      w->target_mean,
-                      lub_mps_elastic_beta(w),
-                      w->load_instant,
-                      w->vmin,
-                      w->vmax,
-                      w->gap_min};
-    lub_table_write_row(F->elastic, row, 11);
-    fflush(F->elastic);
-}
 
 /* Samples line of a wallPressure p.dat: 1 and S, A, B if the file has it. */
 static int read_samples_line(const char *path, long *S, double *A, double *B)
@@ -278,10 +238,7 @@ void lubfoam_functions_start(lubfoam_functions *F, lubfoam_run *r)
             wall_pressure(o, r);
         }
     }
-    if (r->has_elastic) {
-        elastic_open(F, r);
-        elastic_row(F, r);
-    }
+    lub_scene_functions_start(&r->scene, r->start_name, r->t);
 }
 
 static void totals(fo *o, lubfoam_run *r)
@@ -340,7 +297,7 @@ static void wall_pressure(fo *o, lubfoam_run *r)
 
 void lubfoam_functions_execute(lubfoam_functions *F, lubfoam_run *r)
 {
-    if (F->elastic && r->step % F->elastic_interval == 0) elastic_row(F, r);
+    lub_scene_functions_execute(&r->scene, r->t, r->step);
     for (int k = 0; k < F->n; k++) {
         fo *o = &F->f[k];
         if (r->step % o->interval != 0) continue;
@@ -380,7 +337,6 @@ void lubfoam_functions_write(lubfoam_functions *F, lubfoam_run *r)
 void lubfoam_functions_free(lubfoam_functions *F)
 {
     if (!F) return;
-    if (F->elastic) fclose(F->elastic);
     for (int k = 0; k < F->n; k++) {
         if (F->f[k].fp) fclose(F->f[k].fp);
         free(F->f[k].sum);

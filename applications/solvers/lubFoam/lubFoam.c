@@ -190,45 +190,10 @@ static void print_header(const lubfoam_run *r, double average, int others_runnin
         if (len < sizeof models)                                                                   \
             len += (size_t)snprintf(models + len, sizeof models - len, __VA_ARGS__);               \
     } while (0)
-    if (r->has_elastic) LUB_MODELS_ADD("%selasticWall", len ? "; " : "");
     if (r->opt) LUB_MODELS_ADD("%smultiResolution", len ? "; " : "");
 #undef LUB_MODELS_ADD
     lub_message("Models: %s", len ? models : "none (constant/models.yaml)");
-    if (r->has_elastic) {
-        const lub_mps_elastic *w = &r->elastic;
-        lub_message("elasticWall: patch %s (%d wall, %d dummy particles), E %g Pa, load %g N/m "
-                    "over rampTime %g s, b %g m, p_H %g Pa, mean of %ld steps, load balance "
-                    "alpha %g (at most %g m per step), clamp %g; h0 %.6g m, %ld samples",
-                    w->e.patch_name, w->nw, w->nd, w->e.E, w->e.load, w->e.ramp_time, w->e.b,
-                    w->e.p_hertz, w->e.average_steps, w->e.relaxation, w->e.relaxation * w->e.h0,
-                    w->e.clamp, w->h0, w->samples);
-        if (w->nlevels > 1) {
-            /* the segments of the deformation and the load: each point of x on one level */
-            char lv[128 * LUB_MAX_LEVELS];
-            size_t len = 0;
-            for (int k = 0; k < w->nlevels && len < sizeof lv; k++) {
-                int owned = 0;
-                for (int s = 0; s < w->ns; s++) owned += w->src_level[s] == k;
-                len += (size_t)snprintf(lv + len, sizeof lv - len,
-                                        "%slevel %d: %d wall, %d dummy particles, %d of them "
-                                        "pressure segments",
-                                        k ? "; " : "", k, w->lv[k].nw, w->lv[k].nd, owned);
-            }
-            lub_message("elasticWall: %s (the wall pressure where the level owns x; the "
-                        "deformation at every wall particle)",
-                        lv);
-        }
-    }
-}
-
-/* The elastic wall's load error and position, for the log. */
-static void elastic_summary(const lubfoam_run *r, char *buf, size_t size)
-{
-    buf[0] = '\0';
-    if (!r->has_elastic) return;
-    const lub_mps_elastic *w = &r->elastic;
-    snprintf(buf, size, "  load %.4g/%.4g N/m (%+.2f%%) h0 %.5g m", w->load, w->load_target,
-             100.0 * lub_mps_elastic_beta(w), w->h0);
+    lub_scene_header(&r->scene);
 }
 
 /* Viscosity iterations of the last step: the sum over the velocity components (0 when the
@@ -247,7 +212,7 @@ static void log_line(const lubfoam_run *r, long steps_done, double wall0, double
     double el = lub_wtime() - wall0;
     char eta[32], ew[128];
     format_hms(frac > 0 ? el * (1 - frac) / frac : NAN, eta, sizeof eta);
-    elastic_summary(r, ew, sizeof ew);
+    lub_scene_log(&r->scene, ew, sizeof ew);
     if (r->opt) {
         /* per level: pressure and viscosity iterations, surface and given (fixed-band)
          * particles; fluid particles per level and the mass (T-27) against the start's */
@@ -400,7 +365,12 @@ int main(int argc, char **argv)
     lub_mps_config cfg;
     lub_levels levels;
     lub_mps_config_read(&cfg, r.cs.root, &r.P, &levels);
-    lub_scene_read(&r.scene, lub_case_path(&r.cs, path, "constant/models.yaml"), &r.P, &geo, &cfg);
+    lub_scene_read(&r.scene, &r.cs, &r.P, &geo, &cfg);
+    /* the models' restart state, and the end time they check against (a ramp) */
+    char state[LUB_PATH_MAX], what[128];
+    lub_case_pathf(&r.cs, state, "%s/uniform/state.yaml", r.start_name);
+    snprintf(what, sizeof what, "endTime %g of system/controlDict.yaml", r.ctl.end_time);
+    const double end = r.ctl.stop_at == LUB_STOP_ENDTIME ? r.ctl.end_time : 0.0;
     if (levels.nlevels > 0) {
         /* multi-resolution: one solver per level (mps/opt.h); r.P keeps all levels, merged
          * back after every step for the function objects and the time folders */
@@ -408,9 +378,10 @@ int main(int argc, char **argv)
         lub_opt_init(r.opt, &levels, &r.P, &cfg, &geo, 0.5);
         lub_mps *lv[LUB_MAX_LEVELS];
         for (int k = 0; k < r.opt->nlevels; k++) lv[k] = &r.opt->m[k];
-        lub_scene_attach(&r.scene, lv, r.opt->nlevels);
-        lubfoam_read_elastic(&r, &geo);
-        if (r.has_elastic) lub_opt_moving_wall(r.opt, &geo, r.elastic.patch);
+        lub_scene_init(&r.scene, lv, r.opt->nlevels, &r.opt->L, state, end, what);
+        /* walls the models move leave the place where the geometry puts them */
+        for (int p = 0; p < r.P.npatches; p++)
+            if (lv[0]->c.patch_moved[p]) lub_opt_moving_wall(r.opt, &geo, p);
         lub_particles_reserve(&r.P, lub_opt_capacity(r.opt));
         lub_opt_merge(r.opt, &r.P);
         lub_opt_mass m0;
@@ -424,8 +395,7 @@ int main(int argc, char **argv)
     } else {
         lub_mps_init(&r.mps, &r.P, &cfg, geo.dmin, geo.dmax, geo.periodic);
         lub_mps *lv = &r.mps;
-        lub_scene_attach(&r.scene, &lv, 1);
-        lubfoam_read_elastic(&r, &geo);
+        lub_scene_init(&r.scene, &lv, 1, NULL, state, end, what);
     }
     lubfoam_functions *fos = lubfoam_functions_read(&r);
     lub_dict_finish(r.ctl.dict);
@@ -471,19 +441,16 @@ int main(int argc, char **argv)
             r.dt = r.ctl.end_time - r.t; /* land on endTime exactly */
         long bad = -1;
         char msg[1024];
-        lub_step_status s = LUB_STEP_OK;
-        if (r.has_elastic) {
-            s = lub_mps_elastic_before(&r.elastic, r.t, r.dt, msg, sizeof msg);
-            if (s != LUB_STEP_OK) {
-                /* nothing has moved: the current state is good, keep it (unless it is the
-                 * start folder or was just written) */
-                if (tty) fputc('\n', stdout);
-                if (steps > 0 && r.step != last_write_step) {
-                    lub_timer_start(&r.mps.tm, LUB_T_OUTPUT);
-                    lubfoam_write(&r);
-                    lubfoam_functions_write(fos, &r);
-                    lub_timer_stop(&r.mps.tm, LUB_T_OUTPUT);
-                }
+        lub_step_status s = lub_scene_before_step(&r.scene, r.t, r.dt, msg, sizeof msg);
+        if (s != LUB_STEP_OK) {
+            /* nothing has moved: the current state is good, keep it (unless it is the start
+             * folder or was just written) */
+            if (tty) fputc('\n', stdout);
+            if (steps > 0 && r.step != last_write_step) {
+                lub_timer_start(&r.mps.tm, LUB_T_OUTPUT);
+                lubfoam_write(&r);
+                lubfoam_functions_write(fos, &r);
+                lub_timer_stop(&r.mps.tm, LUB_T_OUTPUT);
             }
         }
         if (s == LUB_STEP_OK && r.opt) {
@@ -510,7 +477,7 @@ int main(int argc, char **argv)
             r.step++;
             steps++;
         }
-        if (r.has_elastic) lub_mps_elastic_after(&r.elastic, r.t);
+        lub_scene_after_step(&r.scene, r.t);
         double co, umax;
         if (r.opt) {
             lub_timer_start(run_timers(&r), LUB_T_OTHER);
@@ -582,15 +549,8 @@ int main(int argc, char **argv)
     }
     if (tty && !nothing_to_run) fputc('\n', stdout);
     if (!nothing_to_run) write_cost(&r, steps, lub_wtime() - wall0, pit_sum, vit_sum);
-    if (r.has_elastic && !nothing_to_run) {
-        const lub_mps_elastic *w = &r.elastic;
-        lub_message("elasticWall: t %.9g s: mean load %.6g N/m of %.6g (%+.3f%%), h0 %.9g m, "
-                    "centre %.9g m, v in [%.6g, %.6g] m, closest approach %.6g m",
-                    r.t, w->load, w->load_target, 100.0 * lub_mps_elastic_beta(w), w->h0, w->centre,
-                    w->vmin, w->vmax, w->gap_min);
-    }
+    if (!nothing_to_run) lub_scene_summary(&r.scene, r.t);
     lubfoam_functions_free(fos);
-    lub_mps_elastic_free(&r.elastic);
     if (r.opt) {
         lub_opt_free(r.opt);
         free(r.opt);

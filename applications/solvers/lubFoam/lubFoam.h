@@ -8,7 +8,6 @@
 #include "io/case.h"
 #include "io/control.h"
 #include "models/model.h"
-#include "mps/elastic_wall.h"
 #include "mps/mps.h"
 #include "mps/opt.h"
 
@@ -25,8 +24,6 @@ typedef struct {
     int has_opt_state; /* the start folder's uniform/state.yaml has multiResolution: */
     unsigned long long next_id; /*   the next particle id, */
     double state_mass0;         /*   and M^0 (an exact restart continues both) */
-    int has_elastic;            /* constant/models.yaml has elasticWall */
-    lub_mps_elastic elastic;    /* its state */
     double t, dt;
     long step;
     double start_time;
@@ -45,10 +42,6 @@ static inline const lub_mps *lubfoam_mps0(const lubfoam_run *r)
 
 /* Start time folder per controlDict (startFrom), reading particles and uniform/state.yaml. */
 void lubfoam_read_start(lubfoam_run *r);
-/* The elasticWall model of constant/models.yaml, if any (after lub_mps_init, or lub_opt_init:
- * then on every level): its restart state from the start folder's uniform/state.yaml, the
- * ramp checked against endTime. */
-void lubfoam_read_elastic(lubfoam_run *r, const lub_geometry *geo);
 /* Write the current state as a time folder (atomic), update particles.xdmf, purge. */
 void lubfoam_write(lubfoam_run *r);
 

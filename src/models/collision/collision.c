@@ -87,6 +87,7 @@ void lub_collision_attach(lub_mps *m, const lub_collision *c)
 static void collision_read(lub_model *m, lub_scene *s)
 {
     (void)s;
+    lub_node_expect_map(m->entry);
     lub_collision *c = m->state;
     *c = lub_collision_defaults();
     c->distance = lub_dict_real_or(m->entry, "distance", c->distance, (lub_range){0.0, 1.0, 1, 0});

@@ -14,6 +14,7 @@ typedef struct {
 
 static void gravity_read(lub_model *m, lub_scene *s)
 {
+    lub_node_expect_map(m->entry);
     gravity *g = m->state;
     g->dim = s->P->dim;
     lub_dict_vec(m->entry, "g", g->g, g->dim, g->dim, LUB_ANY);

@@ -133,8 +133,8 @@
  * reordered (or, multi-resolution, compacted) the particles.  No allocation after
  * lub_mps_elastic_init.
  */
-#ifndef LUB_MPS_ELASTIC_WALL_H
-#define LUB_MPS_ELASTIC_WALL_H
+#ifndef LUB_MODELS_ELASTICWALL_H
+#define LUB_MODELS_ELASTICWALL_H
 
 #include <stdint.h>
 #include <stdio.h>
