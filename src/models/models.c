@@ -5,7 +5,7 @@
 
 /* The keys of constant/models.yaml that are not models of the registry (models/registry.h):
  * the fluid's, and the models the solver wires in itself. */
-static const char *const other_keys[] = {"viscosity", "multiResolution", NULL};
+static const char *const other_keys[] = {"viscosity", NULL};
 
 void lub_models_declare(lub_node *root)
 {

@@ -29,6 +29,12 @@ void lub_scene_read(lub_scene *s, const lub_case *cs, lub_particles *P, const lu
         m->type = lub_model_types[k];
         m->entry = entry;
         m->state = m->type->size ? lub_calloc(1, m->type->size) : NULL;
+        if (m->type->build || m->type->advance) {
+            if (s->driver)
+                lub_bug("models '%s' and '%s' both drive the solvers", s->driver->type->name,
+                        m->type->name);
+            s->driver = m;
+        }
         if (m->type->read) m->type->read(m, s);
     }
     if (s->dict) lub_dict_finish(s->dict); /* a misspelt key before the combinations */
@@ -71,20 +77,41 @@ static void attach(lub_scene *s, lub_mps *const *levels, int nlevels)
     }
 }
 
-void lub_scene_init(lub_scene *s, lub_mps *const *level, int nlevels,
-                    const struct lub_levels *levels, const char *state_path, double end_time,
-                    const char *end_what)
+void lub_scene_build(lub_scene *s, const lub_mps_config *c, const char *state_path, double end_time,
+                     const char *end_what)
 {
-    if (nlevels < 1 || nlevels > LUB_MAX_LEVELS) lub_bug("lub_scene_init: %d levels", nlevels);
-    s->nlevels = nlevels;
-    for (int k = 0; k < nlevels; k++) s->level[k] = level[k];
-    s->levels = levels;
     snprintf(s->state_path, sizeof s->state_path, "%s", state_path ? state_path : "");
     s->end_time = end_time;
     snprintf(s->end_what, sizeof s->end_what, "%s", end_what ? end_what : "");
-    attach(s, level, nlevels);
+    if (s->driver) {
+        s->driver->type->build(s->driver, s, c);
+    } else {
+        if (s->P->nlevels > 1)
+            lub_fatal("%s: the particles have %d resolution levels but there is no "
+                      "'multiResolution' entry: add one (e.g. 'multiResolution: { commonDeltaT: "
+                      "true }', etc/templates/models.yaml) or generate a single level (l0 in "
+                      "system/particleGenDict.yaml)",
+                      s->models_path, s->P->nlevels);
+        lub_mps_init(&s->single, s->P, c, s->geo->dmin, s->geo->dmax, s->geo->periodic);
+        s->nlevels = 1;
+        s->level[0] = &s->single;
+        s->nr = 1;
+        s->dt_factor[0] = 1;
+    }
+    if (s->nlevels < 1 || s->nlevels > LUB_MAX_LEVELS || s->nr < 1)
+        lub_bug("lub_scene_build: %d levels, %d steps per step", s->nlevels, s->nr);
+    attach(s, s->level, s->nlevels);
+    /* the models' restart state: each model reads its entry of the start's state.yaml */
+    lub_dict *st = state_path ? lub_dict_read_optional(state_path) : NULL;
+    s->state = st ? lub_dict_root(st) : NULL;
+    lub_models_declare_state(s->state);
     for (int k = 0; k < s->nmodels; k++)
         if (s->model[k].type->init) s->model[k].type->init(&s->model[k], s);
+    if (st) {
+        lub_dict_finish(st);
+        lub_dict_free(st);
+    }
+    s->state = NULL;
 }
 
 void lub_scene_describe(const lub_scene *s, char *buf, size_t size)
@@ -109,6 +136,13 @@ void lub_scene_header(const lub_scene *s)
         if (s->model[k].type->header) s->model[k].type->header(&s->model[k], s);
 }
 
+int lub_scene_header_levels(const lub_scene *s)
+{
+    if (!s->driver || !s->driver->type->header_levels) return 0;
+    s->driver->type->header_levels(s->driver, s);
+    return 1;
+}
+
 void lub_scene_functions_start(lub_scene *s, const char *start, double t)
 {
     for (int k = 0; k < s->nmodels; k++)
@@ -127,10 +161,22 @@ lub_step_status lub_scene_before_step(lub_scene *s, double t, double dt, char *m
     return LUB_STEP_OK;
 }
 
+lub_step_status lub_scene_advance(lub_scene *s, double dt, long *bad, char *msg, size_t msgsize)
+{
+    if (s->driver) return s->driver->type->advance(s->driver, s, s->nr * dt, bad, msg, msgsize);
+    return lub_mps_step(s->level[0], dt, bad, msg, msgsize);
+}
+
 void lub_scene_after_step(lub_scene *s, double t)
 {
     for (int k = 0; k < s->nmodels; k++)
         if (s->model[k].type->after_step) s->model[k].type->after_step(&s->model[k], s, t);
+}
+
+void lub_scene_warn(lub_scene *s, long step)
+{
+    for (int k = 0; k < s->nmodels; k++)
+        if (s->model[k].type->warn) s->model[k].type->warn(&s->model[k], s, step);
 }
 
 void lub_scene_functions_execute(lub_scene *s, double t, long step)
@@ -149,6 +195,81 @@ void lub_scene_log(const lub_scene *s, char *buf, size_t size)
             s->model[k].type->log(&s->model[k], s, buf + len, size - len);
             len += strlen(buf + len);
         }
+}
+
+int lub_scene_log_levels(const lub_scene *s, double dt, double pit, char *buf, size_t size)
+{
+    buf[0] = '\0';
+    if (!s->driver || !s->driver->type->log_levels) return 0;
+    s->driver->type->log_levels(s->driver, s, dt, pit, buf, size);
+    return 1;
+}
+
+/* u_max dt_k / l0 of the level where it is largest, for the finest dt = 1 */
+static double courant_per_dt(const lub_scene *s, int *level)
+{
+    double best = 0;
+    int at = 0;
+    for (int k = 0; k < s->nlevels; k++) {
+        const double c = s->level[k]->st.umax * (double)s->dt_factor[k] / s->level[k]->l0;
+        if (c > best) best = c, at = k;
+    }
+    *level = at;
+    return best;
+}
+
+double lub_scene_courant(const lub_scene *s, double dt, double *umax)
+{
+    const lub_mps *m = s->level[0];
+    if (s->nlevels == 1) {
+        if (umax) *umax = m->st.umax;
+        return m->st.umax * dt / m->l0;
+    }
+    int k;
+    const double c = courant_per_dt(s, &k) * dt;
+    if (umax) *umax = s->level[k]->st.umax;
+    return c;
+}
+
+int lub_scene_dt_limit(const lub_scene *s, double max_courant, double *dt)
+{
+    const lub_mps *m = s->level[0];
+    if (s->nlevels == 1) {
+        if (!(m->st.umax > 0)) return 0;
+        *dt = max_courant * m->l0 / m->st.umax;
+        return 1;
+    }
+    int k;
+    const double c = courant_per_dt(s, &k);
+    if (!(c > 0)) return 0;
+    *dt = max_courant / c; /* every level takes dt: the largest u_max / l0 limits it */
+    return 1;
+}
+
+void lub_scene_iterations(const lub_scene *s, double *p, double *v)
+{
+    *p = *v = 0;
+    for (int k = 0; k < s->nlevels; k++) {
+        *p += s->level[k]->iterations[0];
+        *v += s->level[k]->iterations[1];
+    }
+}
+
+void lub_scene_rebuild_lists(lub_scene *s)
+{
+    for (int k = 0; k < s->nlevels; k++) lub_mps_rebuild_lists(s->level[k]);
+}
+
+int lub_scene_owner(const lub_scene *s, double x)
+{
+    return s->driver && s->driver->type->owner ? s->driver->type->owner(s->driver, x) : 0;
+}
+
+double lub_scene_owned_fraction(const lub_scene *s, int k, double x)
+{
+    return s->driver && s->driver->type->owned_fraction
+               ? s->driver->type->owned_fraction(s->driver, k, x)
+               : 1.0;
 }
 
 void lub_scene_write_state(const lub_scene *s, FILE *fp)
@@ -177,6 +298,7 @@ void lub_scene_free(lub_scene *s)
         if (m->type->free) m->type->free(m);
         free(m->state);
     }
+    if (s->nlevels > 0 && s->level[0] == &s->single) lub_mps_free(&s->single);
     if (s->dict) lub_dict_free(s->dict);
     memset(s, 0, sizeof *s);
 }

@@ -50,7 +50,6 @@
 
 #include "core/timer.h"
 #include "linalg/linsolve.h"
-#include "mps/levels.h"
 #include "mps/neighbours.h"
 #include "particles/particles.h"
 
@@ -90,7 +89,8 @@ typedef struct {
     int patch_moved[LUB_MAX_PATCHES]; /* 1: a model sets the velocity of the patch's wall and
                                          dummy particles before each step (elasticWall) */
 
-    /* set by the multi-resolution driver (mps/opt.h), not read from a dictionary */
+    /* set by the multi-resolution driver (models/multiResolution/opt.h), not read from a dictionary
+     */
     int fixed_flags; /* allocate lub_mps.fixed: particles whose velocity and pressure are given */
     int still_walls; /* wall and dummy particles keep their positions while carrying their
                         patch velocity: every wall is at rest or a plane sliding along itself,
@@ -101,14 +101,10 @@ typedef struct {
 
 /* The defaults of every entry (those of etc/templates/schemes.yaml and solution.yaml). */
 void lub_mps_config_defaults(lub_mps_config *c);
-/* Read the dictionaries of a case into c, checking patch names against the particles'
- * patches.  Fatal (exit 1) with file:line on bad input.  case_dir is the case root.
- * L (may be NULL) receives constant/models.yaml's multiResolution entry, checked against
- * system/particleGenDict.yaml and P (mps/levels.h), or L->nlevels = 0 without one; a
- * configuration the multi-resolution solver (mps/opt.h) cannot run yet is refused, and so is
- * an entry when L is NULL, and particles of several levels without an entry. */
-void lub_mps_config_read(lub_mps_config *c, const char *case_dir, const lub_particles *P,
-                         lub_levels *L);
+/* Read the dictionaries of a case (case_dir: its root) into c: transportProperties, the
+ * viscosity of constant/models.yaml, schemes and solution.  Fatal (exit 1) with file:line on
+ * bad input.  The other entries of models.yaml are the models' (src/models/). */
+void lub_mps_config_read(lub_mps_config *c, const char *case_dir);
 
 /* What the last step did, for the log and the cost table. */
 typedef struct {
@@ -176,22 +172,24 @@ struct lub_mps {
     double *cav;     /* negativePressure cavitation: 1 where the pressure is held at 0 (particle
                         extra field "cavitation", so that it is saved and reordered), else NULL */
     double *lap;
-    uint8_t *fixed;  /* multi-resolution fixed band (T-25, T-26; mps/opt.h): 1 where a fluid or
-                        wall particle's velocity and pressure are given (interpolated from another
-                        level before the step): such a particle is a Dirichlet row of the
-                        viscosity (fluid) and pressure equations, keeps its velocity through the
-                        step and moves with it (r* = r + u dt, no correction, no collision).
-                        Reordered with the particles.  NULL unless config.fixed_flags. */
+    uint8_t *fixed;  /* multi-resolution fixed band (T-25, T-26; models/multiResolution/opt.h): 1
+                        where a fluid or  wall particle's velocity and pressure are given
+                        (interpolated from another  level before the step): such a particle is a
+                        Dirichlet row of the  viscosity (fluid) and pressure equations, keeps its
+                        velocity through the  step and moves with it (r* = r + u dt, no correction, no
+                        collision).  Reordered with the particles.  NULL unless config.fixed_flags. */
     uint8_t *inside; /* multi-resolution: 1 where another level's particles fill the
                         neighbourhood (their PND at the particle's position is at least beta
                         n0 of that level), so the particle is not on a free surface whatever
-                        its own PND (mps/opt.h, Free surface in the overlaps).  Set before the
-                        step, reordered with the particles.  NULL unless config.fixed_flags. */
+                        its own PND (models/multiResolution/opt.h, Free surface in the overlaps).
+                        Set before the step, reordered with the particles.  NULL unless
+                        config.fixed_flags. */
     void *scratch;
     long steps; /* global step count (from the particle file) */
     int built;  /* neighbour lists built once */
 
     lub_mps_stats st;
+    double iterations[2]; /* pressure and viscosity iterations of every step so far */
     lub_timers tm;
 };
 
@@ -199,7 +197,8 @@ struct lub_mps {
  * while the solver runs: the work arrays are allocated for P->cap particles, so P->n may grow
  * up to it between steps).  domain box and periodicity from lo/hi/periodic.  Computes re, n0
  * and lambda0 from l0 (level 0) and writes them into P->levels[0].  P must hold one
- * resolution level: a multi-resolution set is solved level by level (mps/opt.h). */
+ * resolution level: a multi-resolution set is solved level by level (models/multiResolution/opt.h).
+ */
 void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const double lo[3],
                   const double hi[3], const int periodic[3]);
 void lub_mps_free(lub_mps *m);
@@ -233,7 +232,7 @@ lub_step_status lub_mps_check(lub_mps *m, double dt, long *bad, char *msg, size_
  * that velocity; lub_mps_check does not stop the run for them.  flag[i] = 1 (P->n entries)
  * for each given fluid particle that is now more than the check's depth behind its wall
  * layer (the criterion of lub_mps_check, whatever its position before the step); returns
- * their count.  The caller removes them (mps/opt.c). */
+ * their count.  The caller removes them (models/multiResolution/opt.c). */
 size_t lub_mps_buried(const lub_mps *m, double dt, uint8_t *flag);
 
 /* Build the neighbour lists afresh at the next step.  The solver calls it after writing a

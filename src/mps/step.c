@@ -31,7 +31,7 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
     m->dim = P->dim;
     if (P->nlevels > 1)
         lub_bug("lub_mps_init: the particles have %d resolution levels; a solver takes one "
-                "(multi-resolution: one solver per level, mps/opt.h)",
+                "(multi-resolution: one solver per level, models/multiResolution/opt.h)",
                 P->nlevels);
     m->l0 = P->levels[0].l0;
     if (!(m->l0 > 0)) lub_fatal("particle file has no valid l0 for level 0");
@@ -352,8 +352,8 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
  * weighted centroid of the neighbours is further than `asymmetry` l0 from the particle.
  * This geometric refinement plays the role of the thesis' virtual-light test: an interior
  * particle whose PND dropped (a transient rarefaction) has neighbours all around it.  In a
- * multi-resolution overlap (m->inside, set by mps/opt.c) a particle where the other level's
- * particles fill the neighbourhood is not on a surface, whatever its own PND. */
+ * multi-resolution overlap (m->inside, set by models/multiResolution/opt.c) a particle where the
+ * other level's particles fill the neighbourhood is not on a surface, whatever its own PND. */
 static void free_surface(lub_mps *m)
 {
     lub_particles *P = m->P;
@@ -1014,6 +1014,8 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     lub_step_status s = lub_mps_check(m, dt, bad, msg, msgsize);
     m->st.umax = lub_mps_max_speed(m);
     lub_timer_stop(&m->tm, LUB_T_OTHER);
+    m->iterations[0] += m->st.p.iterations;
+    for (int d = 0; d < dim; d++) m->iterations[1] += m->st.v[d].iterations;
     m->steps++;
     return s;
 }

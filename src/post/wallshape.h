@@ -14,8 +14,8 @@
  * system/particleGenDict.yaml with the same levels): every level has its own wall particles
  * in the overlaps, so the curve is made of the wall particles in the part of x their level
  * owns (particleGen's ownership: the first level whose region holds x, else the last; as
- * mps/levels.h), each point of x once, as the elasticWall model counts its load.  Without g
- * (or with a single level) every wall particle of the patch is on the curve.
+ * models/multiResolution/levels.h), each point of x once, as the elasticWall model counts its load.
+ * Without g (or with a single level) every wall particle of the patch is on the curve.
  *
  * The elastic wall (models/elastic.h, models/elasticWall/elasticWall.h) puts wall particle k at
  *

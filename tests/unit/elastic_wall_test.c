@@ -27,9 +27,9 @@
 #include "geometry/discretise.h"
 #include "geometry/geometry.h"
 #include "models/elasticWall/elasticWall.h"
-#include "mps/levels.h"
+#include "models/multiResolution/levels.h"
 #include "mps/mps.h"
-#include "mps/opt.h"
+#include "models/multiResolution/opt.h"
 #include "test.h"
 
 static const char *geom_text = "dimension: 2\n"

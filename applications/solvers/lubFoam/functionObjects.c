@@ -194,12 +194,12 @@ lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
                                "function '%s': no patch '%s' in the particles (patches: %s)", name,
                                patch, list);
             }
-            o->from = lub_dict_real_or(d, "from", lubfoam_mps0(r)->lo[0], LUB_ANY);
-            o->to = lub_dict_real_or(d, "to", lubfoam_mps0(r)->hi[0], LUB_ANY);
+            o->from = lub_dict_real_or(d, "from", r->scene.level[0]->lo[0], LUB_ANY);
+            o->to = lub_dict_real_or(d, "to", r->scene.level[0]->hi[0], LUB_ANY);
             if (!(o->to > o->from))
                 lub_node_error(d, "function '%s': 'to' (%g) must be greater than 'from' (%g)", name,
                                o->to, o->from);
-            o->bin = lub_dict_real_or(d, "bin", 4 * lubfoam_mps0(r)->l0, LUB_POSITIVE);
+            o->bin = lub_dict_real_or(d, "bin", 4 * r->scene.level[0]->l0, LUB_POSITIVE);
             o->t0 = lub_dict_real_or(d, "timeStart", 0.0, LUB_NONNEGATIVE);
             o->t1 = lub_dict_real_or(d, "timeEnd", INFINITY, LUB_NONNEGATIVE);
             if (o->t1 < o->t0)
@@ -244,21 +244,21 @@ void lubfoam_functions_start(lubfoam_functions *F, lubfoam_run *r)
 static void totals(fo *o, lubfoam_run *r)
 {
     const lub_particles *P = &r->P;
-    double mp = r->mps.c.rho * pow(r->mps.l0, P->dim);
+    const lub_scene *sc = &r->scene;
+    const int levels = sc->nlevels > 1;
+    double mp = sc->level[0]->c.rho * pow(sc->level[0]->l0, P->dim);
     double mom[3] = {0, 0, 0}, ke = 0, mass = 0;
     size_t nf = 0;
     for (size_t i = 0; i < P->n; i++) {
         if (P->kind[i] != LUB_FLUID) continue;
-        if (r->opt) {
-            /* multi-resolution: each point of space counted on the level that owns it
+        if (levels) {
+            /* resolution levels: each point of space counted on the level that owns it
              * (T-27): the particle mass of its level times the owned part of its cell;
              * the count is of the particles whose x their level owns */
             const int k = P->level[i];
-            lub_level_where w;
-            lub_levels_locate(&r->opt->L, P->x[0][i], &w);
-            mp = r->opt->m[k].c.rho * pow(r->opt->m[k].l0, P->dim) *
-                 lub_levels_owned_fraction(&r->opt->L, k, P->x[0][i]);
-            if (w.owner == k) nf++;
+            mp = sc->level[k]->c.rho * pow(sc->level[k]->l0, P->dim) *
+                 lub_scene_owned_fraction(sc, k, P->x[0][i]);
+            if (lub_scene_owner(sc, P->x[0][i]) == k) nf++;
         } else {
             nf++;
         }
@@ -268,7 +268,7 @@ static void totals(fo *o, lubfoam_run *r)
             ke += 0.5 * mp * P->u[d][i] * P->u[d][i];
         }
     }
-    double row[7] = {r->t, r->opt ? mass : mp * (double)nf, mom[0], mom[1], mom[2], ke, (double)nf};
+    double row[7] = {r->t, levels ? mass : mp * (double)nf, mom[0], mom[1], mom[2], ke, (double)nf};
     lub_table_write_row(o->fp, row, 7);
     fflush(o->fp);
 }
@@ -281,11 +281,8 @@ static void wall_pressure(fo *o, lubfoam_run *r)
         if (P->kind[i] != LUB_WALL || P->patch[i] != o->patch) continue;
         double x = P->x[0][i];
         if (x < o->from || x >= o->to) continue;
-        if (r->opt) { /* multi-resolution: each x on the level that owns it */
-            lub_level_where w;
-            lub_levels_locate(&r->opt->L, x, &w);
-            if (w.owner != P->level[i]) continue;
-        }
+        /* resolution levels: each x on the level that owns it */
+        if (r->scene.nlevels > 1 && lub_scene_owner(&r->scene, x) != P->level[i]) continue;
         int b = (int)((x - o->from) / o->bin);
         if (b >= o->nbins) b = o->nbins - 1;
         o->sum[b] += P->p[i];

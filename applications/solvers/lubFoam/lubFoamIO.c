@@ -57,12 +57,6 @@ void lubfoam_read_start(lubfoam_run *r)
         r->step = lub_dict_int(root, "step", 0, 1L << 62);
         double dt = lub_dict_real_or(root, "deltaT", c->delta_t, LUB_POSITIVE);
         lub_models_declare_state(root); /* the models read their own entries */
-        lub_node *mr = lub_dict_map_or(root, "multiResolution");
-        if (mr) {
-            r->has_opt_state = 1;
-            r->next_id = (unsigned long long)lub_dict_int(mr, "nextId", 0, 1L << 62);
-            r->state_mass0 = lub_dict_real(mr, "mass0", LUB_NONNEGATIVE);
-        }
         if (c->adjust_time_step) r->dt = dt < c->delta_t ? dt : c->delta_t;
         lub_dict_finish(st);
         lub_dict_free(st);
@@ -83,12 +77,6 @@ static void write_state(const lubfoam_run *r, const char *dir)
     fprintf(fp, "step:   %ld\n", r->step);
     fprintf(fp, "deltaT: %.17g\n", r->dt);
     lub_scene_write_state(&r->scene, fp);
-    if (r->opt)
-        fprintf(fp,
-                "multiResolution:\n"
-                "  nextId: %llu   # id of the next particle generated\n"
-                "  mass0:  %.17g   # fluid mass M^0 at the first start (T-27)\n",
-                (unsigned long long)r->opt->next_id, r->mass0);
     if (fclose(fp) != 0) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
 }
 

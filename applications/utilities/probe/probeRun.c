@@ -87,9 +87,9 @@ static const lub_elastic_wall *ctx_elastic(probe_ctx *x)
     return x->ew_state > 0 ? &x->ew : NULL;
 }
 
-/* The resolution levels of a multi-resolution case (mps/levels.h), read as the solver reads
- * them (constant/models.yaml multiResolution against system/particleGenDict.yaml, checked
- * against the particles P: fatal with file:line when they disagree), or NULL when
+/* The resolution levels of a multi-resolution case (models/multiResolution/levels.h), read as the
+ * solver reads them (constant/models.yaml multiResolution against system/particleGenDict.yaml,
+ * checked against the particles P: fatal with file:line when they disagree), or NULL when
  * models.yaml has no multiResolution entry. */
 static const lub_levels *ctx_levels(probe_ctx *x, const lub_particles *P)
 {

@@ -19,12 +19,40 @@
 #include "io/table.h"
 #include "models/elasticWall/elasticWall.h"
 #include "models/model.h"
+#include "models/multiResolution/levels.h"
 
 typedef struct {
     lub_mps_elastic w;
     FILE *table; /* elasticWall.dat */
     long interval;
 } elastic_model;
+
+/* With multiResolution (s->levels, read before this check): what the elastic wall across
+ * levels cannot run yet, refused with the entries' lines.  It moves every level's wall each
+ * step from one deformation: every level takes the same steps (T-60); it is tested on two
+ * levels (tests/cases/softEHLOPT). */
+static void elastic_check(lub_model *m, lub_scene *s)
+{
+    const lub_levels *L = s->levels;
+    if (!L || L->nlevels < 2) return;
+    const char *file = L->file[0] ? L->file : "constant/models.yaml";
+    if (L->nlevels > 2)
+        lub_node_error(m->entry,
+                       "model 'elasticWall' with 'multiResolution' (%s:%d) runs on 2 levels "
+                       "only, and the case has %d (system/particleGenDict.yaml's levels): the "
+                       "elastic wall across more levels is not supported in this version",
+                       file, L->line, L->nlevels);
+    int nr = 1;
+    for (int k = 0; k < L->nlevels - 1; k++)
+        if (L->level[k].nr > nr) nr = L->level[k].nr;
+    if (nr > 1)
+        lub_node_error(m->entry,
+                       "model 'elasticWall' with 'multiResolution' needs one time step on every "
+                       "level: add 'commonDeltaT: true' to multiResolution (%s:%d; it sub-steps "
+                       "with Nr %d): the wall is deformed and moved before every step of every "
+                       "level from one pressure field (thesis T-60: dt_coarse = dt_fine)",
+                       file, L->line, nr);
+}
 
 static void elastic_init(lub_model *m, lub_scene *s)
 {
@@ -150,6 +178,7 @@ static void elastic_free(lub_model *m)
 const lub_model_type lub_model_elasticWall = {
     .name = "elasticWall",
     .size = sizeof(elastic_model),
+    .check = elastic_check,
     .init = elastic_init,
     .header = elastic_header,
     .functions_start = elastic_functions_start,

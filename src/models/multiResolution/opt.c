@@ -1,5 +1,5 @@
 /* lubkit MPS: the overlapping particle technique, multi-resolution driver (see opt.h). */
-#include "mps/opt.h"
+#include "models/multiResolution/opt.h"
 
 #include <math.h>
 #include <omp.h>

@@ -1,5 +1,5 @@
 /* lubkit MPS: resolution levels of the overlapping particle technique (see levels.h). */
-#include "mps/levels.h"
+#include "models/multiResolution/levels.h"
 
 #include <math.h>
 #include <stdio.h>

@@ -73,14 +73,14 @@
  * Mass correction (T-27..T-29; T-61 without cMin): when |M^k - M^0| > threshold M^0, the
  * particles of the overlaps get the x-velocity correction B sgn(M^k - M^0) (sign chosen by the
  * solver to drive the mass back, per boundary), B = max(min(|M^k - M^0| / (rho A C_relax dt),
- * cMax), cMin); mps/opt.h.
+ * cMax), cMin); models/multiResolution/opt.h.
  *
  * Errors are fatal with file:line of the entry (models.yaml, or particleGenDict.yaml for the
  * regions it owns); the reader asks for every key it knows, so lub_dict_finish() on
  * models.yaml reports unknown keys in multiResolution.
  */
-#ifndef LUB_MPS_LEVELS_H
-#define LUB_MPS_LEVELS_H
+#ifndef LUB_MODELS_LEVELS_H
+#define LUB_MODELS_LEVELS_H
 
 #include "geometry/geometry.h"
 #include "io/dict.h"
