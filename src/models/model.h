@@ -58,6 +58,7 @@
 #include "geometry/geometry.h"
 #include "io/case.h"
 #include "io/dict.h"
+#include "models/fluid.h"
 #include "mps/mps.h"
 #include "particles/particles.h"
 
@@ -119,6 +120,7 @@ struct lub_scene {
     const lub_geometry *geo;        /* the geometry (system/particleGenDict.yaml); set-up only */
     char models_path[LUB_PATH_MAX]; /* constant/models.yaml */
     lub_dict *dict;                 /* constant/models.yaml (NULL: none) */
+    const lub_fluid_type *fluid;    /* its formulation (fluid: { type }, models/fluid.h) */
     int nmodels;
     lub_model model[LUB_MAX_MODELS]; /* in the order of the registry */
     lub_model *driver; /* the model with build and advance (multiResolution), or NULL */
@@ -144,9 +146,10 @@ struct lub_scene {
 extern const lub_model_type *const lub_model_types[];
 const lub_model_type *lub_model_type_find(const char *name);
 
-/* Read the case's constant/models.yaml (a missing file lists no model) and set up the models
- * it lists: read, then check, then configure on c.  Fatal (exit 1) with file:line on bad
- * input, a misspelt model name or key included. */
+/* Read the case's constant/models.yaml (a missing file lists no model): the fluid's
+ * formulation reads its dictionaries into c (models/fluid.h), then the models it lists are
+ * set up: read, then check, then configure on c.  Fatal (exit 1) with file:line on bad input,
+ * a misspelt model name or key included. */
 void lub_scene_read(lub_scene *s, const lub_case *cs, lub_particles *P, const lub_geometry *geo,
                     lub_mps_config *c);
 /* Build the fluid's solvers from c (the driver's build, else one solver for the particles;
@@ -158,10 +161,11 @@ void lub_scene_build(lub_scene *s, const lub_mps_config *c, const char *state_pa
                      const char *end_what);
 /* The "Models:" list of the header (empty without a model). */
 void lub_scene_describe(const lub_scene *s, char *buf, size_t size);
-/* Every model's header lines (the driver's: header_levels). */
+/* The fluid's header lines: its levels (the driver's header_levels, else the formulation's
+ * line of the one solver), its schemes and solvers. */
+void lub_scene_header_fluid(const lub_scene *s);
+/* Every model's header lines. */
 void lub_scene_header(const lub_scene *s);
-/* The driver's lines about the levels; 0 without a driver. */
-int lub_scene_header_levels(const lub_scene *s);
 void lub_scene_functions_start(lub_scene *s, const char *start, double t);
 /* Before the step from t to t + dt: the first failure (msg) stops the others. */
 lub_step_status lub_scene_before_step(lub_scene *s, double t, double dt, char *msg, size_t msgsize);
@@ -176,9 +180,9 @@ void lub_scene_warn(lub_scene *s, long step);
 void lub_scene_functions_execute(lub_scene *s, double t, long step);
 /* The models' parts of the log line, each with its leading separator. */
 void lub_scene_log(const lub_scene *s, char *buf, size_t size);
-/* The driver's part about the levels (dt: the finest level's, pit: the mean pressure
- * iterations per step); 0 without a driver. */
-int lub_scene_log_levels(const lub_scene *s, double dt, double pit, char *buf, size_t size);
+/* The fluid's part of the log line (the driver's log_levels, else the formulation's; dt: the
+ * finest level's, pit: the mean pressure iterations per step so far). */
+void lub_scene_log_fluid(const lub_scene *s, double dt, double pit, char *buf, size_t size);
 
 /* The Courant number u_max dt / l0 of the last step (T-18), the largest over the levels, each
  * with its own dt = dt_factor dt (dt: the finest level's); *umax (may be NULL): the speed

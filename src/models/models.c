@@ -4,8 +4,8 @@
 #include "models/model.h"
 
 /* The keys of constant/models.yaml that are not models of the registry (models/registry.h):
- * the fluid's, and the models the solver wires in itself. */
-static const char *const other_keys[] = {"viscosity", NULL};
+ * the fluid's (models/fluid.h; viscosity: the formulation mps's). */
+static const char *const other_keys[] = {"fluid", "viscosity", NULL};
 
 void lub_models_declare(lub_node *root)
 {

@@ -18,6 +18,8 @@ void lub_scene_read(lub_scene *s, const lub_case *cs, lub_particles *P, const lu
     s->dict = lub_dict_read_optional(s->models_path);
     lub_node *root = s->dict ? lub_dict_root(s->dict) : NULL;
     lub_models_declare(root);
+    s->fluid = lub_fluid_type_read(root);
+    s->fluid->read(c, cs, root, lub_dict_find(root, "fluid"));
     for (int k = 0; lub_model_types[k]; k++) {
         /* found, not looked into: a model that reads its entry elsewhere (elasticWall: from
          * its own copy of the file) leaves it unjudged here */
@@ -136,11 +138,13 @@ void lub_scene_header(const lub_scene *s)
         if (s->model[k].type->header) s->model[k].type->header(&s->model[k], s);
 }
 
-int lub_scene_header_levels(const lub_scene *s)
+void lub_scene_header_fluid(const lub_scene *s)
 {
-    if (!s->driver || !s->driver->type->header_levels) return 0;
-    s->driver->type->header_levels(s->driver, s);
-    return 1;
+    if (s->driver && s->driver->type->header_levels)
+        s->driver->type->header_levels(s->driver, s);
+    else if (s->fluid->header_level)
+        s->fluid->header_level(s->level[0]);
+    if (s->fluid->header) s->fluid->header(s->level[0]);
 }
 
 void lub_scene_functions_start(lub_scene *s, const char *start, double t)
@@ -164,7 +168,7 @@ lub_step_status lub_scene_before_step(lub_scene *s, double t, double dt, char *m
 lub_step_status lub_scene_advance(lub_scene *s, double dt, long *bad, char *msg, size_t msgsize)
 {
     if (s->driver) return s->driver->type->advance(s->driver, s, s->nr * dt, bad, msg, msgsize);
-    return lub_mps_step(s->level[0], dt, bad, msg, msgsize);
+    return s->fluid->step(s->level[0], dt, bad, msg, msgsize);
 }
 
 void lub_scene_after_step(lub_scene *s, double t)
@@ -197,12 +201,13 @@ void lub_scene_log(const lub_scene *s, char *buf, size_t size)
         }
 }
 
-int lub_scene_log_levels(const lub_scene *s, double dt, double pit, char *buf, size_t size)
+void lub_scene_log_fluid(const lub_scene *s, double dt, double pit, char *buf, size_t size)
 {
     buf[0] = '\0';
-    if (!s->driver || !s->driver->type->log_levels) return 0;
-    s->driver->type->log_levels(s->driver, s, dt, pit, buf, size);
-    return 1;
+    if (s->driver && s->driver->type->log_levels)
+        s->driver->type->log_levels(s->driver, s, dt, pit, buf, size);
+    else if (s->fluid->log)
+        s->fluid->log(s->level[0], dt, pit, buf, size);
 }
 
 /* u_max dt_k / l0 of the level where it is largest, for the finest dt = 1 */

@@ -27,8 +27,6 @@
 #include "core/error.h"
 #include "io/case.h"
 #include "io/dict.h"
-#include "models/models.h"
-#include "models/transport.h"
 #include "mps/mps.h"
 #include "mps/operators.h"
 
@@ -119,30 +117,11 @@ static void read_solution(lub_mps_config *c, const char *path)
     }
 }
 
-static void read_models(lub_mps_config *c, const char *path)
-{
-    static const char *const visc[] = {"explicit", "crankNicolson", NULL};
-    lub_dict *d = lub_dict_read_optional(path);
-    lub_node *r = d ? lub_dict_root(d) : NULL;
-    if (r) lub_models_declare(r);
-    /* the other entries are the models of src/models/ (models/model.h) */
-    lub_node *v = lub_dict_map_or(r, "viscosity");
-    c->viscosity = v ? 1 + lub_dict_choice(v, "scheme", visc, 1) : LUB_VISCOSITY_NONE;
-    if (d) {
-        lub_dict_finish(d);
-        lub_dict_free(d);
-    }
-}
-
 void lub_mps_config_read(lub_mps_config *c, const char *case_dir)
 {
     lub_case cs;
     char path[LUB_PATH_MAX];
-    lub_mps_config_defaults(c);
     lub_case_open(&cs, case_dir);
-    lub_transport_read(lub_case_path(&cs, path, "constant/transportProperties.yaml"), &c->rho,
-                       &c->nu);
-    read_models(c, lub_case_path(&cs, path, "constant/models.yaml"));
     read_schemes(c, lub_case_path(&cs, path, "system/schemes.yaml"));
     read_solution(c, lub_case_path(&cs, path, "system/solution.yaml"));
 }

@@ -39,8 +39,9 @@
  * on a patch with patch_moved set, with the velocity a model gave them before the step
  * (elasticWall: models/elasticWall/elasticWall.h).
  *
- * Configuration comes from system/schemes.yaml, system/solution.yaml, constant/models.yaml
- * and constant/transportProperties.yaml (lub_mps_config_read); the state is a lub_particles
+ * Configuration comes from system/schemes.yaml, system/solution.yaml (lub_mps_config_read),
+ * constant/transportProperties.yaml and constant/models.yaml (the fluid and the models of
+ * src/models/ fill in the rest); the state is a lub_particles
  * plus work arrays allocated once (lub_mps_init): the step never allocates.
  */
 #ifndef LUB_MPS_MPS_H
@@ -89,8 +90,7 @@ typedef struct {
     int patch_moved[LUB_MAX_PATCHES]; /* 1: a model sets the velocity of the patch's wall and
                                          dummy particles before each step (elasticWall) */
 
-    /* set by the multi-resolution driver (models/multiResolution/opt.h), not read from a dictionary
-     */
+    /* set by a model that drives the solvers (multiResolution), not read from a dictionary */
     int fixed_flags; /* allocate lub_mps.fixed: particles whose velocity and pressure are given */
     int still_walls; /* wall and dummy particles keep their positions while carrying their
                         patch velocity: every wall is at rest or a plane sliding along itself,
@@ -101,9 +101,9 @@ typedef struct {
 
 /* The defaults of every entry (those of etc/templates/schemes.yaml and solution.yaml). */
 void lub_mps_config_defaults(lub_mps_config *c);
-/* Read the dictionaries of a case (case_dir: its root) into c: transportProperties, the
- * viscosity of constant/models.yaml, schemes and solution.  Fatal (exit 1) with file:line on
- * bad input.  The other entries of models.yaml are the models' (src/models/). */
+/* Read the case's (case_dir: its root) system/schemes.yaml and system/solution.yaml into c
+ * (set to the defaults, and rho, nu and the viscosity scheme, by the caller: the fluid of
+ * src/models/fluid/mps.c).  Fatal (exit 1) with file:line on bad input. */
 void lub_mps_config_read(lub_mps_config *c, const char *case_dir);
 
 /* What the last step did, for the log and the cost table. */
@@ -172,18 +172,17 @@ struct lub_mps {
     double *cav;     /* negativePressure cavitation: 1 where the pressure is held at 0 (particle
                         extra field "cavitation", so that it is saved and reordered), else NULL */
     double *lap;
-    uint8_t *fixed;  /* multi-resolution fixed band (T-25, T-26; models/multiResolution/opt.h): 1
-                        where a fluid or  wall particle's velocity and pressure are given
-                        (interpolated from another  level before the step): such a particle is a
-                        Dirichlet row of the  viscosity (fluid) and pressure equations, keeps its
-                        velocity through the  step and moves with it (r* = r + u dt, no correction, no
-                        collision).  Reordered with the particles.  NULL unless config.fixed_flags. */
-    uint8_t *inside; /* multi-resolution: 1 where another level's particles fill the
-                        neighbourhood (their PND at the particle's position is at least beta
-                        n0 of that level), so the particle is not on a free surface whatever
-                        its own PND (models/multiResolution/opt.h, Free surface in the overlaps).
-                        Set before the step, reordered with the particles.  NULL unless
-                        config.fixed_flags. */
+    /* Given particles: the pressure-equation contributions (and the velocities) of a model,
+     * set before the step (multiResolution's fixed band, T-25, T-26).  Reordered with the
+     * particles; NULL unless config.fixed_flags. */
+    uint8_t *fixed;  /* 1 where a fluid or wall particle's velocity and pressure are given: it
+                        is a Dirichlet row of the viscosity (fluid) and pressure equations, keeps
+                        its velocity through the step and moves with it (r* = r + u dt, no
+                        correction, no collision) */
+    uint8_t *inside; /* 1 where a model knows the particle is inside the fluid, so that it is not
+                        on a free surface whatever its own PND (multiResolution: the other
+                        level's particles fill the neighbourhood, opt.h, Free surface in the
+                        overlaps) */
     void *scratch;
     long steps; /* global step count (from the particle file) */
     int built;  /* neighbour lists built once */
@@ -218,11 +217,12 @@ typedef enum {
  * time folder). */
 lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize);
 
-/* The checks at the end of lub_mps_step, on the current state: the first particle with a
+/* The checks at the end of lub_mps_step (mps/walls.c, shared by the fluid's formulations), on
+ * the current state: the first particle with a
  * non-finite value (LUB_STEP_NONFINITE) or outside the domain box in a non-periodic direction
  * (LUB_STEP_ESCAPED), then the first fluid particle that went through a wall in the step of
  * length dt that brought the particles here, their positions before it being r - u dt
- * (LUB_STEP_ESCAPED, naming the wall's patch; the criterion is described in step.c).  *bad
+ * (LUB_STEP_ESCAPED, naming the wall's patch; the criterion is described in walls.c).  *bad
  * and msg as for lub_mps_step.  Uses the neighbour lists of the step: a caller that places
  * particles itself builds them first (lub_neighbours_build(&m->nb, P->n, P->x)). */
 lub_step_status lub_mps_check(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize);

@@ -129,9 +129,6 @@ static void print_header(const lubfoam_run *r, double average, int others_runnin
     const lub_mps *m = r->scene.level[0];
     size_t cnt[3] = {0, 0, 0};
     for (size_t i = 0; i < r->P.n; i++) cnt[r->P.kind[i] < 3 ? r->P.kind[i] : 0]++;
-    char ps[256], vs[256];
-    lub_linsolver_describe(&m->psolver, ps, sizeof ps);
-    lub_linsolver_describe(&m->vsolver, vs, sizeof vs);
     lub_message("lubFoam: case %s, start time %s (step %ld), %d-D", r->cs.root, r->start_name,
                 r->step, m->dim);
     lub_message("Particles: %zu (fluid %zu, wall %zu, dummy %zu), threads %d", r->P.n, cnt[0],
@@ -144,27 +141,7 @@ static void print_header(const lubfoam_run *r, double average, int others_runnin
                     "wait for each other on shared cores can make every step several times "
                     "slower; OMP_NUM_THREADS=%d may be faster",
                     average, others_running, omp_get_num_procs(), omp_get_max_threads(), fit);
-    if (!lub_scene_header_levels(&r->scene))
-        lub_message("MPS: l0 %g m, re %g m (%g l0), n0 %.10g, lambda0 %.10g m^2", m->l0, m->re,
-                    m->c.re_l0, m->n0, m->lambda0);
-    char order[64];
-    if (m->c.reorder_interval == 1)
-        snprintf(order, sizeof order, "%s every step", m->c.order_rows ? "rows" : "cells");
-    else if (m->c.reorder_interval > 1)
-        snprintf(order, sizeof order, "%s every %d steps", m->c.order_rows ? "rows" : "cells",
-                 m->c.reorder_interval);
-    else
-        snprintf(order, sizeof order, "never");
-    lub_message("Schemes: gradient %s%s, gamma %g, alpha %g, surface beta %g, viscosity %s; "
-                "particles sorted into %s",
-                m->c.gradient == LUB_GRADIENT_LSMPS ? "lsmps" : "standard",
-                m->c.min_pressure_shift ? " (min-pressure shift)" : "", m->c.gamma, m->c.alpha,
-                m->c.beta,
-                m->c.viscosity == LUB_VISCOSITY_NONE       ? "none"
-                : m->c.viscosity == LUB_VISCOSITY_EXPLICIT ? "explicit"
-                                                           : "crankNicolson",
-                order);
-    lub_message("Solvers: p %s; U %s", ps, vs);
+    lub_scene_header_fluid(&r->scene);
     /* the models of constant/models.yaml this run has (a scene enables only those it needs) */
     char models[1024];
     lub_scene_describe(&r->scene, models, sizeof models);
@@ -173,34 +150,17 @@ static void print_header(const lubfoam_run *r, double average, int others_runnin
     lub_scene_header(&r->scene);
 }
 
-/* Viscosity iterations of the last step: the sum over the velocity components (0 when the
- * viscosity is explicit or absent). */
-static int viscosity_iterations(const lub_mps *m)
-{
-    int it = 0;
-    for (int d = 0; d < m->dim; d++) it += m->st.v[d].iterations;
-    return it;
-}
-
 static void log_line(const lubfoam_run *r, long steps_done, double wall0, double pit_sum)
 {
-    const lub_mps *m = r->scene.level[0];
     double frac = fraction_done(r, steps_done);
     double el = lub_wtime() - wall0;
-    char eta[32], ew[128], lv[256 * LUB_MAX_LEVELS];
+    char eta[32], ew[128], fluid[256 * LUB_MAX_LEVELS];
     format_hms(frac > 0 ? el * (1 - frac) / frac : NAN, eta, sizeof eta);
     lub_scene_log(&r->scene, ew, sizeof ew);
-    const double pit = steps_done ? pit_sum / (double)steps_done : 0.0;
-    if (lub_scene_log_levels(&r->scene, r->dt, pit, lv, sizeof lv)) {
-        lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g %sETA %s%s", r->t,
-                    100 * frac, r->step, r->dt, lub_scene_courant(&r->scene, r->dt, NULL), lv, eta,
-                    ew);
-        return;
-    }
-    lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g p %3d it %8.2e (mean %.1f)  "
-                "U %3d it  surf %-6zu ETA %s%s",
-                r->t, 100 * frac, r->step, r->dt, m->st.umax * r->dt / m->l0, m->st.p.iterations,
-                m->st.p.residual, pit, viscosity_iterations(m), m->st.nsurface, eta, ew);
+    lub_scene_log_fluid(&r->scene, r->dt, steps_done ? pit_sum / (double)steps_done : 0.0, fluid,
+                        sizeof fluid);
+    lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g %sETA %s%s", r->t, 100 * frac,
+                r->step, r->dt, lub_scene_courant(&r->scene, r->dt, NULL), fluid, eta, ew);
 }
 
 static void progress_bar(const lubfoam_run *r, long steps_done, double wall0)
@@ -314,9 +274,8 @@ int main(int argc, char **argv)
     if (r.P.dim != geo.dim)
         lub_fatal("the particles are %d-D but system/particleGenDict.yaml says dimension %d",
                   r.P.dim, geo.dim);
-    /* the fluid's configuration, the models the scene lists and the solvers they need */
+    /* the fluid and the models the scene lists, and the solvers they need */
     lub_mps_config cfg;
-    lub_mps_config_read(&cfg, r.cs.root);
     lub_scene_read(&r.scene, &r.cs, &r.P, &geo, &cfg);
     char state[LUB_PATH_MAX], what[128];
     lub_case_pathf(&r.cs, state, "%s/uniform/state.yaml", r.start_name);

@@ -35,6 +35,16 @@ static void mr_read(lub_model *m, lub_scene *s)
     s->levels = &r->L;
 }
 
+/* The levels take steps of semi-implicit MPS (lub_opt_step: lub_mps_step on each level). */
+static void mr_check(lub_model *m, lub_scene *s)
+{
+    if (s->fluid->step != lub_mps_step)
+        lub_node_error(m->entry,
+                       "model 'multiResolution' couples levels of the fluid 'mps' (semi-implicit "
+                       "MPS), not of '%s' (the fluid entry of constant/models.yaml)",
+                       s->fluid->name);
+}
+
 static void mr_build(lub_model *m, lub_scene *s, const lub_mps_config *c)
 {
     /* one solver per level; the scene's particles keep all levels, merged back after every
@@ -199,6 +209,7 @@ const lub_model_type lub_model_multiResolution = {
     .name = "multiResolution",
     .size = sizeof(multires),
     .read = mr_read,
+    .check = mr_check,
     .build = mr_build,
     .init = mr_init,
     .header_levels = mr_header_levels,
