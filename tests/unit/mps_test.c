@@ -9,7 +9,7 @@
 #include "mps/neighbours.h"
 #include "particles/particles.h"
 #include "mps/operators.h"
-#include "mps/weight.h"
+#include "particles/weight.h"
 #include "test.h"
 
 /* deterministic random numbers in [0, 1) (xorshift64*) */

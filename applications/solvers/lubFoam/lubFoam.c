@@ -16,7 +16,7 @@
 #include "core/error.h"
 #include "core/timer.h"
 #include "geometry/geometry.h"
-#include "io/particles_io.h"
+#include "particles/particles_io.h"
 #include "io/table.h"
 #include "lubFoam.h"
 

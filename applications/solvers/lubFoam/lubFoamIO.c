@@ -6,7 +6,7 @@
 
 #include "core/error.h"
 #include "io/dict.h"
-#include "io/particles_io.h"
+#include "particles/particles_io.h"
 #include "models/models.h"
 #include "lubFoam.h"
 

@@ -11,7 +11,7 @@
 #include <sys/stat.h>
 
 #include "core/error.h"
-#include "io/particles_io.h"
+#include "particles/particles_io.h"
 #include "models/transport.h"
 #include "models/models.h"
 #include "post/film.h"

@@ -10,7 +10,7 @@
 #include "core/error.h"
 #include "geometry/discretise.h"
 #include "mps/operators.h"
-#include "mps/weight.h"
+#include "particles/weight.h"
 
 /* ---- particles: split, fill, merge ------------------------------------------------------ */
 
