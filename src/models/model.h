@@ -19,8 +19,9 @@
  *   build       (the driver only) set up the fluid's solvers itself: s->nlevels, s->level,
  *               s->levels, s->nr, s->dt_factor (multiResolution: one solver per resolution
  *               level); without a driver the scene builds one solver for the particles
- *   init        after the solvers (s->level): its fields in the particles (saved in the
- *               time folders), its restart state (s->state_path), checks against endTime
+ *   init        after the solvers (s->level): its fields in the particles of the levels
+ *               (saved in the time folders), its restart state (s->state: its entry of the
+ *               start's uniform/state.yaml), checks against endTime; the driver's last
  *   header      its lines of the log's header (after describe's "Models:" line)
  *   functions_start    its tables under postProcessing/ (a run with a step to take)
  *
@@ -34,7 +35,8 @@
  *   forces             step 2 of every level's step: add a uniform body acceleration
  *   after_correction   step 9, after the velocity and position correction: collision
  *   after_step         after every level's step, the time now t + dt (elasticWall: the
- *                      running mean of the wall pressure)
+ *                      running mean of the wall pressure); the driver's last (it gathers the
+ *                      levels into the scene's particles)
  *   warn               after after_step: warnings about the step (each once, as it sees fit)
  *   functions_execute  its tables, after after_step
  *   log                its part of the log line

@@ -107,8 +107,11 @@ void lub_scene_build(lub_scene *s, const lub_mps_config *c, const char *state_pa
     lub_dict *st = state_path ? lub_dict_read_optional(state_path) : NULL;
     s->state = st ? lub_dict_root(st) : NULL;
     lub_models_declare_state(s->state);
+    /* the driver last: it gathers the levels (their fields included) into the particles */
     for (int k = 0; k < s->nmodels; k++)
-        if (s->model[k].type->init) s->model[k].type->init(&s->model[k], s);
+        if (s->model[k].type->init && &s->model[k] != s->driver)
+            s->model[k].type->init(&s->model[k], s);
+    if (s->driver && s->driver->type->init) s->driver->type->init(s->driver, s);
     if (st) {
         lub_dict_finish(st);
         lub_dict_free(st);
@@ -173,8 +176,11 @@ lub_step_status lub_scene_advance(lub_scene *s, double dt, long *bad, char *msg,
 
 void lub_scene_after_step(lub_scene *s, double t)
 {
+    /* the driver last: it gathers the levels into the particles the output reads */
     for (int k = 0; k < s->nmodels; k++)
-        if (s->model[k].type->after_step) s->model[k].type->after_step(&s->model[k], s, t);
+        if (s->model[k].type->after_step && &s->model[k] != s->driver)
+            s->model[k].type->after_step(&s->model[k], s, t);
+    if (s->driver && s->driver->type->after_step) s->driver->type->after_step(s->driver, s, t);
 }
 
 void lub_scene_warn(lub_scene *s, long step)
