@@ -50,7 +50,7 @@ void lub_mps_laplacian(const lub_neighbours *nb, const lub_mps_mask *mask, doubl
 {
     const mask_view mv = view(mask);
     const size_t n = nb->n;
-    const double c = 2.0 * nb->dim / (lambda0 * n0); /* (T-3) */
+    const double c = lub_mps_laplacian_coefficient(nb->dim, lambda0, n0, 1.0); /* (T-3) */
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         if (!takes_part(mv.ikind, mv.i, i)) continue;

@@ -41,6 +41,14 @@ typedef struct {
 
 /* The reference values n0 and lambda0 (T-4, T-5): lub_mps_reference, particles/weight.h. */
 
+/* The coefficient of the Laplacian (T-3) times a caller's factor: scale 2d / (lambda0 n0),
+ * formed in that order (scale 2 d, then the division), so that the viscous step's factor
+ * dt nu / 2 (T-31) gives the bits of the expression written out. */
+static inline double lub_mps_laplacian_coefficient(int dim, double lambda0, double n0, double scale)
+{
+    return scale * 2.0 * dim / (lambda0 * n0);
+}
+
 /* PND n_i = sum_{j != i} w_ij (T-4, T-11). */
 void lub_mps_pnd(const lub_neighbours *nb, const lub_mps_mask *mask, double *pnd);
 

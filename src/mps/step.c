@@ -252,7 +252,7 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
     if (gold) smooth_fluid(m, m->gbar, m->grad);
     if (m->c.viscosity == LUB_VISCOSITY_EXPLICIT) {
         /* (T-3, T-7) with the dummy particles' ghost velocity (see dummy_velocity) */
-        const double cl = 2.0 * dim / (m->lambda0 * m->n0), nu = m->c.nu;
+        const double cl = lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, 1.0), nu = m->c.nu;
         const lub_neighbours *nb = &m->nb;
         const double gm = m->c.mirror_dummies ? 2.0 : 1.0;
 #pragma omp parallel for schedule(static)
@@ -272,7 +272,7 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
         /* (T-31): u*_i - (dt nu/2) <lap u*>_i = u_i + (dt nu/2) <lap u^k>_i + dt g, with the
          * wall, dummy (and fixed-band) velocities known.  Rows: the other fluid particles;
          * symmetric since w_ij is. */
-        const double k = 0.5 * dt * m->c.nu * 2.0 * dim / (m->lambda0 * m->n0);
+        const double k = lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, 0.5 * dt * m->c.nu);
         const lub_neighbours *nb = &m->nb;
         const double gm = m->c.mirror_dummies ? 2.0 : 1.0;
         int nf = 0;
@@ -464,7 +464,7 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
     lub_particles *P = m->P;
     const lub_neighbours *nb = &m->nb;
     const size_t n = P->n;
-    const double c = 2.0 * m->dim / (m->lambda0 * m->n0);
+    const double c = lub_mps_laplacian_coefficient(m->dim, m->lambda0, m->n0, 1.0);
     const double src = m->c.gamma * m->c.rho / (dt * dt) / m->n0;
     const double alpha = m->c.alpha;
     /* multi-resolution fixed band: the given pressure P->p of a fixed particle is a Dirichlet

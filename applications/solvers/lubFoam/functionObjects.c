@@ -41,6 +41,7 @@
 #include "core/error.h"
 #include "io/table.h"
 #include "lubFoam.h"
+#include "models/multiResolution/levels.h"
 
 enum { FO_TOTALS, FO_WALLPRESSURE };
 
@@ -245,30 +246,36 @@ static void totals(fo *o, lubfoam_run *r)
 {
     const lub_particles *P = &r->P;
     const lub_scene *sc = &r->scene;
-    const int levels = sc->nlevels > 1;
-    double mp = sc->level[0]->c.rho * pow(sc->level[0]->l0, P->dim);
     double mom[3] = {0, 0, 0}, ke = 0, mass = 0;
     size_t nf = 0;
-    for (size_t i = 0; i < P->n; i++) {
-        if (P->kind[i] != LUB_FLUID) continue;
-        if (levels) {
-            /* resolution levels: each point of space counted on the level that owns it
-             * (T-27): the particle mass of its level times the owned part of its cell;
-             * the count is of the particles whose x their level owns */
-            const int k = P->level[i];
-            mp = sc->level[k]->c.rho * pow(sc->level[k]->l0, P->dim) *
-                 lub_scene_owned_fraction(sc, k, P->x[0][i]);
-            if (lub_scene_owner(sc, P->x[0][i]) == k) nf++;
-        } else {
+    if (sc->levels) {
+        /* resolution levels: each point of space counted on the level that owns it (T-27):
+         * the particle mass of its level times the owned part of its cell; the count is of
+         * the particles whose x their level owns (as probe totals and the mass correction) */
+        lub_levels_sums s;
+        memset(&s, 0, sizeof s);
+        lub_levels_sum(sc->levels, P, &s);
+        double m[LUB_MAX_LEVELS];
+        for (int k = 0; k < sc->nlevels; k++) {
+            m[k] = sc->level[k]->c.rho * pow(sc->level[k]->l0, P->dim);
+            nf += s.owned[k];
+            for (int d = 0; d < 3; d++) mom[d] += m[k] * s.fu[k][d];
+            ke += 0.5 * m[k] * s.fu2[k];
+        }
+        mass = lub_levels_mass(&s, sc->nlevels, m);
+    } else {
+        const double mp = sc->level[0]->c.rho * pow(sc->level[0]->l0, P->dim);
+        for (size_t i = 0; i < P->n; i++) {
+            if (P->kind[i] != LUB_FLUID) continue;
             nf++;
+            for (int d = 0; d < P->dim; d++) {
+                mom[d] += mp * P->u[d][i];
+                ke += 0.5 * mp * P->u[d][i] * P->u[d][i];
+            }
         }
-        mass += mp;
-        for (int d = 0; d < P->dim; d++) {
-            mom[d] += mp * P->u[d][i];
-            ke += 0.5 * mp * P->u[d][i] * P->u[d][i];
-        }
+        mass = mp * (double)nf;
     }
-    double row[7] = {r->t, levels ? mass : mp * (double)nf, mom[0], mom[1], mom[2], ke, (double)nf};
+    double row[7] = {r->t, mass, mom[0], mom[1], mom[2], ke, (double)nf};
     lub_table_write_row(o->fp, row, 7);
     fflush(o->fp);
 }

@@ -328,10 +328,10 @@ int main(int argc, char **argv)
              * folder or was just written) */
             if (tty) fputc('\n', stdout);
             if (steps > 0 && r.step != last_write_step) {
-                lub_timer_start(&r.scene.single.tm, LUB_T_OUTPUT);
+                lub_timer_start(run_timers(&r), LUB_T_OUTPUT);
                 lubfoam_write(&r);
                 lubfoam_functions_write(fos, &r);
-                lub_timer_stop(&r.scene.single.tm, LUB_T_OUTPUT);
+                lub_timer_stop(run_timers(&r), LUB_T_OUTPUT);
             }
         }
         if (s == LUB_STEP_OK) s = lub_scene_advance(&r.scene, r.dt, &bad, msg, sizeof msg);
