@@ -22,7 +22,8 @@
  *   init        after the solvers (s->level): its fields in the particles of the levels
  *               (saved in the time folders), its restart state (s->state: its entry of the
  *               start's uniform/state.yaml), checks against endTime; the driver's last
- *   header      its lines of the log's header (after describe's "Models:" line)
+ *   describe    its entry in the "Models:" line of the log's header (default: its name)
+ *   header      its lines of the log's header (after the "Models:" line)
  *   functions_start    its tables under postProcessing/ (a run with a step to take)
  *
  * and at every step (methods.md §2), from time t to t + dt:
@@ -41,15 +42,14 @@
  *   functions_execute  its tables, after after_step
  *   log                its part of the log line
  *
- * A driver also describes the levels: header_levels (the levels' header lines),
- * log_levels (their part of the log line), and which level owns a point (owner,
- * owned_fraction: each point of space counted on one level, T-27).
- *
  * and write_state (its entry in the time folders' uniform/state.yaml, for an exact restart),
- * summary (its lines at the end of the run), free.
+ * summary (its lines at the end of the run), free.  A driver also describes the levels:
+ * header_levels (the levels' header lines), log_levels (their part of the log line), and
+ * which level owns a point (owner: each point of space counted on one level, T-27).
  *
  * Adding a model: a folder src/models/<name>/ with <name>.c defining
- * `const lub_model_type lub_model_<name>`, and the line LUB_MODEL(<name>) in registry.h.
+ * `const lub_model_type lub_model_<name>`, and the line LUB_MODEL(<name>) in registry.h
+ * (src/README.md names the example).
  */
 #ifndef LUB_MODELS_MODEL_H
 #define LUB_MODELS_MODEL_H
@@ -100,7 +100,6 @@ typedef struct lub_model_type {
     void (*log_levels)(const lub_model *m, const lub_scene *s, double dt, double pit, char *buf,
                        size_t size);
     int (*owner)(const lub_model *m, double x);
-    double (*owned_fraction)(const lub_model *m, int level, double x);
 
     void (*write_state)(const lub_model *m, const lub_scene *s, FILE *fp);
     void (*summary)(const lub_model *m, const lub_scene *s, double t);
@@ -146,7 +145,6 @@ struct lub_scene {
 /* The registry: every model type, NULL-terminated, in the order of registry.h (the order
  * in which the models of a scene act at each point). */
 extern const lub_model_type *const lub_model_types[];
-const lub_model_type *lub_model_type_find(const char *name);
 
 /* Read the case's constant/models.yaml (a missing file lists no model): the fluid's
  * formulation reads its dictionaries into c (models/fluid.h), then the models it lists are
@@ -200,12 +198,8 @@ void lub_scene_iterations(const lub_scene *s, double *p, double *v);
 void lub_scene_rebuild_lists(lub_scene *s);
 /* The level that owns x (each point of space on one level, T-27; 0 with one level). */
 int lub_scene_owner(const lub_scene *s, double x);
-/* The part of a level-k particle's cell at x that its level owns (1 with one level). */
-double lub_scene_owned_fraction(const lub_scene *s, int k, double x);
 void lub_scene_write_state(const lub_scene *s, FILE *fp);
 void lub_scene_summary(const lub_scene *s, double t);
-/* The model of that name, or NULL when the scene does not list it. */
-lub_model *lub_scene_find(const lub_scene *s, const char *name);
 void lub_scene_free(lub_scene *s);
 
 #endif

@@ -1,5 +1,4 @@
 /* lubkit models: the registry of model types (models/registry.h, models/model.h). */
-#include <string.h>
 
 #include "core/error.h"
 #include "models/fluid.h"
@@ -35,11 +34,4 @@ const lub_fluid_type *lub_fluid_type_read(lub_node *models)
     names[n] = NULL;
     lub_node *entry = lub_dict_map_or(models, "fluid");
     return lub_fluid_types[lub_dict_choice(entry, "type", names, 0)];
-}
-
-const lub_model_type *lub_model_type_find(const char *name)
-{
-    for (int k = 0; lub_model_types[k]; k++)
-        if (strcmp(lub_model_types[k]->name, name) == 0) return lub_model_types[k];
-    return NULL;
 }

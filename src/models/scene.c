@@ -276,13 +276,6 @@ int lub_scene_owner(const lub_scene *s, double x)
     return s->driver && s->driver->type->owner ? s->driver->type->owner(s->driver, x) : 0;
 }
 
-double lub_scene_owned_fraction(const lub_scene *s, int k, double x)
-{
-    return s->driver && s->driver->type->owned_fraction
-               ? s->driver->type->owned_fraction(s->driver, k, x)
-               : 1.0;
-}
-
 void lub_scene_write_state(const lub_scene *s, FILE *fp)
 {
     for (int k = 0; k < s->nmodels; k++)
@@ -293,13 +286,6 @@ void lub_scene_summary(const lub_scene *s, double t)
 {
     for (int k = 0; k < s->nmodels; k++)
         if (s->model[k].type->summary) s->model[k].type->summary(&s->model[k], s, t);
-}
-
-lub_model *lub_scene_find(const lub_scene *s, const char *name)
-{
-    for (int k = 0; k < s->nmodels; k++)
-        if (strcmp(s->model[k].type->name, name) == 0) return (lub_model *)&s->model[k];
-    return NULL;
 }
 
 void lub_scene_free(lub_scene *s)

@@ -1,4 +1,4 @@
-/* The solver's check for fluid particles going through a wall (src/mps/step.c,
+/* The solver's check for fluid particles going through a wall (src/mps/walls.c,
  * lub_mps_check): particleGen-style walls (one wall layer, two dummy layers) with a fluid
  * particle placed, and given the velocity that brought it there in a step of dt (its
  * position before the step is r - u dt), at the places the criterion must tell apart:

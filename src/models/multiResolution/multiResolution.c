@@ -7,8 +7,8 @@
  *
  * The driver of the scene (models/model.h): it builds the levels' solvers (build) and takes
  * their coupled step (advance: lub_opt_step), merges the levels into the scene's particles
- * after every step (after_step), says which level owns a point (owner, owned_fraction: the
- * mass of T-27, the function objects), and keeps the next particle id and the mass M^0 of
+ * after every step (after_step), says which level owns a point (owner: T-27's ownership, for
+ * the function objects), and keeps the next particle id and the mass M^0 of
  * the run's first start in uniform/state.yaml (an exact restart continues both). */
 #include <stdio.h>
 #include <string.h>
@@ -183,11 +183,6 @@ static int mr_owner(const lub_model *m, double x)
     return w.owner;
 }
 
-static double mr_owned_fraction(const lub_model *m, int level, double x)
-{
-    return lub_levels_owned_fraction(&((const multires *)m->state)->o.L, level, x);
-}
-
 static void mr_write_state(const lub_model *m, const lub_scene *s, FILE *fp)
 {
     (void)s;
@@ -218,7 +213,6 @@ const lub_model_type lub_model_multiResolution = {
     .warn = mr_warn,
     .log_levels = mr_log_levels,
     .owner = mr_owner,
-    .owned_fraction = mr_owned_fraction,
     .write_state = mr_write_state,
     .free = mr_free,
 };
