@@ -8,7 +8,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "io/dict.h"
+#include "core/spell.h"
 
 #ifndef LUB_VERSION
 #define LUB_VERSION "0.0.0"

@@ -1,6 +1,6 @@
 /* lubkit geometry discretisation (see discretise.h for the lattice and the rules). */
 #include "geometry/discretise.h"
-#include "mps/operators.h"
+#include "particles/weight.h"
 
 #include <math.h>
 #include <stdint.h>

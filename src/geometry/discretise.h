@@ -51,7 +51,7 @@ void lub_geometry_discretise(const lub_geometry *g, lub_particles *P, double mem
  * owned that range (same lattice, same wall sampling and fluid rules as
  * lub_geometry_discretise), into P (initialised here; all levels and patches of g set).  An
  * empty result is not an error.  The multi-resolution solver fills the overlap margins with
- * it (particleGen generates each level only where it owns x; mps/opt.h). */
+ * it (particleGen generates each level only where it owns x; models/multiResolution/opt.h). */
 void lub_geometry_discretise_range(const lub_geometry *g, int level, double xlo, double xhi,
                                    lub_particles *P);
 

@@ -20,6 +20,8 @@
 #include <math.h>
 #include <stddef.h>
 
+#include "core/spell.h" /* lub_closest: the readers' "did you mean" */
+
 typedef struct lub_dict lub_dict;
 typedef struct lub_node lub_node;
 
@@ -117,11 +119,5 @@ lub_node *lub_dict_seq_or(lub_node *map, const char *key); /* NULL if absent */
 
 /* Fatal unless a node is a mapping / sequence (for list items). */
 lub_node *lub_node_expect_map(lub_node *n);
-
-/* ---- helpers -------------------------------------------------------------------------- */
-
-/* Levenshtein distance, and the closest candidate within a reasonable distance (or NULL). */
-int lub_edit_distance(const char *a, const char *b);
-const char *lub_closest(const char *word, const char *const *candidates, size_t n);
 
 #endif

@@ -114,7 +114,7 @@ int lub_elastic_floor(const lub_geometry *g, const lub_elastic_wall *e, double x
  * that the load balance uses.  Returns 0, or -1 when the points are not strictly sorted. */
 int lub_elastic_segment_widths(int n, const double *x, double fallback, double *w);
 
-/* Particle fields of the model in the particle solver (mps/elastic_wall.h; saved in
+/* Particle fields of the model in the particle solver (models/elasticWall/elasticWall.h; saved in
  * particles.h5): the running mean of the wall pressure and the undeformed shape. */
 #define LUB_ELASTIC_FIELD_MEAN  "pWallMean"
 #define LUB_ELASTIC_FIELD_SHAPE "elasticShape"

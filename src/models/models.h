@@ -18,13 +18,15 @@
 #include "geometry/geometry.h"
 #include "io/dict.h"
 
-/* Every model name of constant/models.yaml, NULL-terminated. */
-extern const char *const lub_model_names[];
-
-/* Mark every model name as known in the root mapping of models.yaml. */
+/* Mark every model name (models/registry.h) and the fluid's keys as known in the root
+ * mapping of models.yaml. */
 void lub_models_declare(lub_node *root);
 
-/* movingWalls: { <wallName>: { velocity: [u, v(, w)] } }.
+/* The same for the root of a time folder's uniform/state.yaml: the solver's entries (time,
+ * step, deltaT) and the models' (each model reads its own). */
+void lub_models_declare_state(lub_node *root);
+
+/* movingWalls: { <wallName>: { velocity: [u, v(, w)] } } (models/movingWalls/movingWalls.c).
  * Fills vel[w] (velocity of wall w of g, zero when not listed; 2-D vectors get w = 0) and
  * moving[w] (1 when listed); both sized g->nwalls.  A name that is not a wall of the geometry
  * is fatal with file:line and the list of wall names.  root may be NULL (no models).

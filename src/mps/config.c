@@ -28,9 +28,6 @@
 #include "core/error.h"
 #include "io/case.h"
 #include "io/dict.h"
-#include "models/models.h"
-#include "models/transport.h"
-#include "mps/levels.h"
 #include "mps/mps.h"
 #include "mps/lsmps.h"
 #include "mps/operators.h"
@@ -70,8 +67,6 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->v_solver.pcg.precond = LUB_PRECOND_JACOBI;
     c->v_solver.pcg.warm_start = 1;
     c->viscosity = LUB_VISCOSITY_NONE;
-    c->collision_distance = 0.8;
-    c->restitution = 0.2;
 }
 
 static void read_linsolver(lub_node *map, lub_linsolver_options *o, int *cont)
@@ -152,111 +147,11 @@ static void read_solution(lub_mps_config *c, const char *path)
     }
 }
 
-/* What the multi-resolution solver (mps/opt.h) cannot run yet: refused with the entry's
- * line.  Called after lub_dict_finish, so that a misspelt key is reported first. */
-static void check_supported(const lub_levels *L, lub_node *mr, lub_node *root)
-{
-    /* the elastic wall across levels (mps/elastic_wall.h) moves every level's wall each step
-     * from one deformation: every level takes the same steps (T-60); it is tested on two
-     * levels (tests/cases/softEHLOPT) */
-    lub_node *ew = lub_dict_find(root, "elasticWall");
-    if (ew && L->nlevels > 2)
-        lub_node_error(ew,
-                       "model 'elasticWall' with 'multiResolution' (%s:%d) runs on 2 levels "
-                       "only, and the case has %d (system/particleGenDict.yaml's levels): the "
-                       "elastic wall across more levels is not supported in this version",
-                       lub_node_file(mr) ? lub_node_file(mr) : "constant/models.yaml",
-                       lub_node_line(mr), L->nlevels);
-    int nr = 1;
-    for (int k = 0; k < L->nlevels - 1; k++)
-        if (L->level[k].nr > nr) nr = L->level[k].nr;
-    if (ew && nr > 1)
-        lub_node_error(ew,
-                       "model 'elasticWall' with 'multiResolution' needs one time step on every "
-                       "level: add 'commonDeltaT: true' to multiResolution (%s:%d; it sub-steps "
-                       "with Nr %d): the wall is deformed and moved before every step of every "
-                       "level from one pressure field (thesis T-60: dt_coarse = dt_fine)",
-                       lub_node_file(mr) ? lub_node_file(mr) : "constant/models.yaml",
-                       lub_node_line(mr), nr);
-}
-
-static void read_models(lub_mps_config *c, const char *path, const char *geometry_path,
-                        const lub_particles *P, lub_levels *L)
-{
-    static const char *const visc[] = {"explicit", "crankNicolson", NULL};
-    lub_dict *d = lub_dict_read_optional(path);
-    lub_node *r = d ? lub_dict_root(d) : NULL;
-    if (r) lub_models_declare(r);
-
-    lub_node *g = lub_dict_map_or(r, "gravity");
-    c->gravity = g != NULL;
-    memset(c->g, 0, sizeof c->g);
-    if (g) lub_dict_vec(g, "g", c->g, P->dim, P->dim, LUB_ANY);
-
-    /* movingWalls names patches of the particle file: present them as walls */
-    lub_geometry geo = {0};
-    lub_wall walls[LUB_MAX_PATCHES];
-    memset(walls, 0, sizeof walls);
-    geo.dim = P->dim;
-    geo.nwalls = P->npatches;
-    geo.walls = walls;
-    for (int k = 0; k < P->npatches; k++)
-        snprintf(walls[k].name, sizeof walls[k].name, "%s", P->patch_names[k]);
-    int moving[LUB_MAX_PATCHES];
-    lub_moving_walls_read(r, &geo, c->patch_velocity, moving);
-
-    lub_node *v = lub_dict_map_or(r, "viscosity");
-    c->viscosity = v ? 1 + lub_dict_choice(v, "scheme", visc, 1) : LUB_VISCOSITY_NONE;
-
-    lub_node *col = lub_dict_map_or(r, "collision");
-    c->collision = col != NULL;
-    c->collision_distance =
-        lub_dict_real_or(col, "distance", c->collision_distance, (lub_range){0.0, 1.0, 1, 0});
-    c->restitution = lub_dict_real_or(col, "restitution", c->restitution, LUB_UNIT);
-
-    /* elasticWall is read by mps/elastic_wall.c (it needs the geometry) */
-    /* multiResolution is read and checked by mps/levels.c against particleGenDict's levels,
-     * so that a bad entry is reported with its line; a caller without L cannot run it */
-    lub_node *mr = lub_dict_find(r, "multiResolution");
-    if (L) L->nlevels = 0;
-    if (mr) {
-        lub_levels lv;
-        char desc[1024];
-        lub_levels_read_case(&lv, mr, geometry_path, P);
-        lub_dict_finish(d); /* a misspelt key first */
-        lub_levels_describe(&lv, desc, sizeof desc);
-        if (!L)
-            lub_node_error(mr,
-                           "model 'multiResolution' is not available in this program (the "
-                           "entry is valid: %s)",
-                           desc);
-        check_supported(&lv, mr, r);
-        *L = lv;
-    } else if (P->nlevels > 1) {
-        lub_fatal("%s: the particles have %d resolution levels but there is no "
-                  "'multiResolution' entry: add one (e.g. 'multiResolution: { commonDeltaT: "
-                  "true }', etc/templates/models.yaml) or generate a single level (l0 in "
-                  "system/particleGenDict.yaml)",
-                  path, P->nlevels);
-    }
-    if (d) {
-        lub_dict_finish(d);
-        lub_dict_free(d);
-    }
-}
-
-void lub_mps_config_read(lub_mps_config *c, const char *case_dir, const lub_particles *P,
-                         lub_levels *L)
+void lub_mps_config_read(lub_mps_config *c, const char *case_dir)
 {
     lub_case cs;
     char path[LUB_PATH_MAX];
-    lub_mps_config_defaults(c);
     lub_case_open(&cs, case_dir);
-    lub_transport_read(lub_case_path(&cs, path, "constant/transportProperties.yaml"), &c->rho,
-                       &c->nu);
-    char geometry_path[LUB_PATH_MAX];
-    lub_case_path(&cs, geometry_path, "system/particleGenDict.yaml");
-    read_models(c, lub_case_path(&cs, path, "constant/models.yaml"), geometry_path, P, L);
     read_schemes(c, lub_case_path(&cs, path, "system/schemes.yaml"));
     read_solution(c, lub_case_path(&cs, path, "system/solution.yaml"));
 }

@@ -5,7 +5,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "mps/weight.h"
+#include "particles/weight.h"
 
 enum { MT = LUB_LSQ_MAX_TERMS, MF = LUB_LSQ_MAX_FIELDS };
 

@@ -15,8 +15,12 @@
  *        pressure would be undetermined; st.nisolated)
  *     7. pressure gradient                         standard (T-13, T-14) or LSMPS (T-15)
  *     8. u^{k+1} = u* - dt/rho grad p, r^{k+1} = r* + (u^{k+1} - u*) dt   (T-16, T-17)
- *     9. collision, periodic wrap, checks (non-finite values, the domain box, a fluid
- *        particle through a wall: lub_mps_check)
+ *     9. the models' corrections (collision), periodic wrap, checks (non-finite values, the
+ *        domain box, a fluid particle through a wall: lub_mps_check)
+ *
+ * Models act at named points of the step through lub_mps.hooks (src/models/model.h fills
+ * them in for the models of a scene): forces in step 2 (gravity), after the correction in
+ * step 9 (collision).  The step knows no model by name.
  *
  * Pressure predictor (schemes.yaml pressure.predictor, not in the thesis).  Without it, a
  * steady flow balances grad p / rho = nu lap(u*) with u* = u + dt grad p / rho: the viscous
@@ -34,10 +38,11 @@
  * Walls are one layer of wall particles (pressure solved) with dummy layers behind them (PND
  * only).  Wall and dummy particles move with the velocity of their patch (movingWalls), or,
  * on a patch with patch_moved set, with the velocity a model gave them before the step
- * (elasticWall: mps/elastic_wall.h).
+ * (elasticWall: models/elasticWall/elasticWall.h).
  *
- * Configuration comes from system/schemes.yaml, system/solution.yaml, constant/models.yaml
- * and constant/transportProperties.yaml (lub_mps_config_read); the state is a lub_particles
+ * Configuration comes from system/schemes.yaml, system/solution.yaml (lub_mps_config_read),
+ * constant/transportProperties.yaml and constant/models.yaml (the fluid and the models of
+ * src/models/ fill in the rest); the state is a lub_particles
  * plus work arrays allocated once (lub_mps_init): the step never allocates.
  */
 #ifndef LUB_MPS_MPS_H
@@ -48,7 +53,6 @@
 #include "core/timer.h"
 #include "linalg/bicgstab.h"
 #include "linalg/linsolve.h"
-#include "mps/levels.h"
 #include "mps/neighbours.h"
 #include "particles/particles.h"
 
@@ -88,17 +92,14 @@ typedef struct {
 
     /* constant/ */
     double rho, nu;
-    int gravity;
-    double g[3];
+    int gravity;   /* a uniform body acceleration g given with the configuration (callers */
+    double g[3];   /* without models; the models of a scene add theirs: hooks.forces) */
     int viscosity; /* LUB_VISCOSITY_* */
-    double patch_velocity[LUB_MAX_PATCHES][3];
+    double patch_velocity[LUB_MAX_PATCHES][3]; /* wall velocities (movingWalls) */
     int patch_moved[LUB_MAX_PATCHES]; /* 1: a model sets the velocity of the patch's wall and
                                          dummy particles before each step (elasticWall) */
-    int collision;
-    double collision_distance; /* in l0 */
-    double restitution;
 
-    /* set by the multi-resolution driver (mps/opt.h), not read from a dictionary */
+    /* set by a model that drives the solvers (multiResolution), not read from a dictionary */
     int fixed_flags; /* allocate lub_mps.fixed: particles whose velocity and pressure are given */
     int still_walls; /* wall and dummy particles keep their positions while carrying their
                         patch velocity: every wall is at rest or a plane sliding along itself,
@@ -109,14 +110,10 @@ typedef struct {
 
 /* The defaults of every entry (those of etc/templates/schemes.yaml and solution.yaml). */
 void lub_mps_config_defaults(lub_mps_config *c);
-/* Read the dictionaries of a case into c, checking patch names against the particles'
- * patches.  Fatal (exit 1) with file:line on bad input.  case_dir is the case root.
- * L (may be NULL) receives constant/models.yaml's multiResolution entry, checked against
- * system/particleGenDict.yaml and P (mps/levels.h), or L->nlevels = 0 without one; a
- * configuration the multi-resolution solver (mps/opt.h) cannot run yet is refused, and so is
- * an entry when L is NULL, and particles of several levels without an entry. */
-void lub_mps_config_read(lub_mps_config *c, const char *case_dir, const lub_particles *P,
-                         lub_levels *L);
+/* Read the case's (case_dir: its root) system/schemes.yaml and system/solution.yaml into c
+ * (set to the defaults, and rho, nu and the viscosity scheme, by the caller: the fluid of
+ * src/models/fluid/mps.c).  Fatal (exit 1) with file:line on bad input. */
+void lub_mps_config_read(lub_mps_config *c, const char *case_dir);
 
 /* What the last step did, for the log and the cost table. */
 typedef struct {
@@ -142,8 +139,23 @@ enum {
 };
 extern const char *const lub_mps_phase_names[]; /* neighbourSearch, viscositySolve, ... */
 
+typedef struct lub_mps lub_mps;
+
+/* What the models do inside the step (methods.md §2), at its named points; ctx is passed
+ * back.  Each may be NULL. */
 typedef struct {
+    void *ctx;
+    /* step 2, viscosity and body force: add the step's uniform body acceleration [m/s^2] to
+     * acc (it holds the configuration's g); returns 1 if it added one */
+    int (*forces)(void *ctx, const lub_mps *m, double dt, double acc[3]);
+    /* step 9, after the correction (u^{k+1}, r^{k+1}) and before the periodic wrap and the
+     * checks: a change of the fluid particles' velocities and positions (collision) */
+    void (*after_correction)(void *ctx, lub_mps *m, double dt);
+} lub_mps_hooks;
+
+struct lub_mps {
     lub_mps_config c;
+    lub_mps_hooks hooks; /* zero: no model acts in the step */
     lub_particles *P;
     int dim;
     double l0, re, n0, lambda0;
@@ -179,30 +191,32 @@ typedef struct {
     double *cav;     /* negativePressure cavitation: 1 where the pressure is held at 0 (particle
                         extra field "cavitation", so that it is saved and reordered), else NULL */
     double *lap;
-    uint8_t *fixed;  /* multi-resolution fixed band (T-25, T-26; mps/opt.h): 1 where a fluid or
-                        wall particle's velocity and pressure are given (interpolated from another
-                        level before the step): such a particle is a Dirichlet row of the
-                        viscosity (fluid) and pressure equations, keeps its velocity through the
-                        step and moves with it (r* = r + u dt, no correction, no collision).
-                        Reordered with the particles.  NULL unless config.fixed_flags. */
-    uint8_t *inside; /* multi-resolution: 1 where another level's particles fill the
-                        neighbourhood (their PND at the particle's position is at least beta
-                        n0 of that level), so the particle is not on a free surface whatever
-                        its own PND (mps/opt.h, Free surface in the overlaps).  Set before the
-                        step, reordered with the particles.  NULL unless config.fixed_flags. */
+    /* Given particles: the pressure-equation contributions (and the velocities) of a model,
+     * set before the step (multiResolution's fixed band, T-25, T-26).  Reordered with the
+     * particles; NULL unless config.fixed_flags. */
+    uint8_t *fixed;  /* 1 where a fluid or wall particle's velocity and pressure are given: it
+                        is a Dirichlet row of the viscosity (fluid) and pressure equations, keeps
+                        its velocity through the step and moves with it (r* = r + u dt, no
+                        correction, no collision) */
+    uint8_t *inside; /* 1 where a model knows the particle is inside the fluid, so that it is not
+                        on a free surface whatever its own PND (multiResolution: the other
+                        level's particles fill the neighbourhood, opt.h, Free surface in the
+                        overlaps) */
     void *scratch;
     long steps; /* global step count (from the particle file) */
     int built;  /* neighbour lists built once */
 
     lub_mps_stats st;
+    double iterations[2]; /* pressure and viscosity iterations of every step so far */
     lub_timers tm;
-} lub_mps;
+};
 
 /* Set up the solver for particles P (the state lives in P; its capacity must not change
  * while the solver runs: the work arrays are allocated for P->cap particles, so P->n may grow
  * up to it between steps).  domain box and periodicity from lo/hi/periodic.  Computes re, n0
  * and lambda0 from l0 (level 0) and writes them into P->levels[0].  P must hold one
- * resolution level: a multi-resolution set is solved level by level (mps/opt.h). */
+ * resolution level: a multi-resolution set is solved level by level (models/multiResolution/opt.h).
+ */
 void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const double lo[3],
                   const double hi[3], const int periodic[3]);
 void lub_mps_free(lub_mps *m);
@@ -214,7 +228,7 @@ typedef enum {
     LUB_STEP_NONFINITE,    /* NaN or Inf in a particle value */
     LUB_STEP_ESCAPED,      /* a particle left the domain through a non-periodic side, or a
                               fluid particle went through a wall (elasticWall: a wall would
-                              cross the plate, mps/elastic_wall.h) */
+                              cross the plate, models/elasticWall/elasticWall.h) */
 } lub_step_status;
 
 /* Advance by dt.  On failure, *bad is the index of the first offending particle (or -1) and
@@ -222,11 +236,12 @@ typedef enum {
  * time folder). */
 lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize);
 
-/* The checks at the end of lub_mps_step, on the current state: the first particle with a
+/* The checks at the end of lub_mps_step (mps/walls.c, shared by the fluid's formulations), on
+ * the current state: the first particle with a
  * non-finite value (LUB_STEP_NONFINITE) or outside the domain box in a non-periodic direction
  * (LUB_STEP_ESCAPED), then the first fluid particle that went through a wall in the step of
  * length dt that brought the particles here, their positions before it being r - u dt
- * (LUB_STEP_ESCAPED, naming the wall's patch; the criterion is described in step.c).  *bad
+ * (LUB_STEP_ESCAPED, naming the wall's patch; the criterion is described in walls.c).  *bad
  * and msg as for lub_mps_step.  Uses the neighbour lists of the step: a caller that places
  * particles itself builds them first (lub_neighbours_build(&m->nb, P->n, P->x)). */
 lub_step_status lub_mps_check(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize);
@@ -236,7 +251,7 @@ lub_step_status lub_mps_check(lub_mps *m, double dt, long *bad, char *msg, size_
  * that velocity; lub_mps_check does not stop the run for them.  flag[i] = 1 (P->n entries)
  * for each given fluid particle that is now more than the check's depth behind its wall
  * layer (the criterion of lub_mps_check, whatever its position before the step); returns
- * their count.  The caller removes them (mps/opt.c). */
+ * their count.  The caller removes them (models/multiResolution/opt.c). */
 size_t lub_mps_buried(const lub_mps *m, double dt, uint8_t *flag);
 
 /* Build the neighbour lists afresh at the next step.  The solver calls it after writing a
@@ -247,6 +262,11 @@ static inline void lub_mps_rebuild_lists(lub_mps *m)
 {
     m->built = 0;
 }
+
+/* Build the neighbour lists afresh now, at the current positions (a model that moved the
+ * particles within the step and needs every pair: the collision model); timed as the
+ * neighbour search. */
+void lub_mps_relist(lub_mps *m);
 
 /* Largest speed of all particles (fluid and moving walls). */
 double lub_mps_max_speed(const lub_mps *m);

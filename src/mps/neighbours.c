@@ -7,7 +7,7 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "mps/weight.h"
+#include "particles/weight.h"
 
 /* The cells are made this much (relative) larger than rs, so that the round-off of
  * (x - lo) / h never puts two particles closer than rs two cells apart. */

@@ -65,7 +65,7 @@
 /* Cells are at least rs / reach wide (reach: 2, or 1 when cells of rs / 2 would number more
  * than LUB_NEIGHBOURS_FINE_CELLS_MAX): every particle within rs of a point lies in the cells
  * at most `reach` cells away from the point's cell in each direction (a user of the cell
- * grid, such as mps/opt.c, must look that far). */
+ * grid, such as models/multiResolution/opt.c, must look that far). */
 #define LUB_NEIGHBOURS_MAX_REACH      2
 #define LUB_NEIGHBOURS_FINE_CELLS_MAX 16777216.0
 /* Storage blocks of the lists (see Storage above): one per thread, at most this many. */

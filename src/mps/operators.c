@@ -4,7 +4,7 @@
 #include <math.h>
 
 #include "core/error.h"
-#include "mps/weight.h"
+#include "particles/weight.h"
 
 /* Kind array and bit masks for i and j; kind NULL when everyone takes part. */
 typedef struct {
@@ -30,26 +30,6 @@ static inline int takes_part(const uint8_t *kind, unsigned bits, size_t i)
     return !kind || (kind[i] < 8 && ((bits >> kind[i]) & 1u));
 }
 
-void lub_mps_reference(int dim, double l0, double re, double *n0, double *lambda0)
-{
-    if ((dim != 2 && dim != 3) || !(l0 > 0) || !(re > 0))
-        lub_bug("reference PND: dim %d, l0 %g, re %g", dim, l0, re);
-    /* (T-4, T-5): every lattice node within re of the centre node */
-    const int m = (int)ceil(re / l0) + 1, mz = dim == 3 ? m : 0;
-    double sw = 0.0, sr2w = 0.0;
-    for (int c = -mz; c <= mz; c++)
-        for (int b = -m; b <= m; b++)
-            for (int a = -m; a <= m; a++) {
-                if (a == 0 && b == 0 && c == 0) continue;
-                double r2 = l0 * l0 * ((double)a * a + (double)b * b + (double)c * c);
-                double w = lub_mps_weight(sqrt(r2), re);
-                sw += w;
-                sr2w += r2 * w;
-            }
-    *n0 = sw;
-    *lambda0 = sr2w / sw;
-}
-
 void lub_mps_pnd(const lub_neighbours *nb, const lub_mps_mask *mask, double *pnd)
 {
     const mask_view mv = view(mask);
@@ -70,7 +50,7 @@ void lub_mps_laplacian(const lub_neighbours *nb, const lub_mps_mask *mask, doubl
 {
     const mask_view mv = view(mask);
     const size_t n = nb->n;
-    const double c = 2.0 * nb->dim / (lambda0 * n0); /* (T-3) */
+    const double c = lub_mps_laplacian_coefficient(nb->dim, lambda0, n0, 1.0); /* (T-3) */
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         if (!takes_part(mv.ikind, mv.i, i)) continue;

@@ -24,6 +24,7 @@
 #include <stdint.h>
 
 #include "mps/neighbours.h"
+#include "particles/weight.h"
 
 #define LUB_MPS_KIND(k) (1u << (k))
 #define LUB_MPS_ALL     0xffu
@@ -38,10 +39,15 @@ typedef struct {
 /* Default for the LSMPS degeneracy test (see lub_mps_gradient_lsmps). */
 #define LUB_MPS_LSMPS_DET_MIN 1e-2
 
-/* Reference PND n0 and lambda0 (T-4, T-5) of a full square (2-D) or cubic (3-D) lattice of
- * spacing l0, around one of its particles:
- *     n0 = sum_j w(|r_j|, re),   lambda0 = sum_j |r_j|^2 w(|r_j|, re) / n0. */
-void lub_mps_reference(int dim, double l0, double re, double *n0, double *lambda0);
+/* The reference values n0 and lambda0 (T-4, T-5): lub_mps_reference, particles/weight.h. */
+
+/* The coefficient of the Laplacian (T-3) times a caller's factor: scale 2d / (lambda0 n0),
+ * formed in that order (scale 2 d, then the division), so that the viscous step's factor
+ * dt nu / 2 (T-31) gives the bits of the expression written out. */
+static inline double lub_mps_laplacian_coefficient(int dim, double lambda0, double n0, double scale)
+{
+    return scale * 2.0 * dim / (lambda0 * n0);
+}
 
 /* PND n_i = sum_{j != i} w_ij (T-4, T-11). */
 void lub_mps_pnd(const lub_neighbours *nb, const lub_mps_mask *mask, double *pnd);

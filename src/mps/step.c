@@ -1,4 +1,7 @@
-/* lubkit MPS: one semi-implicit MPS step for one resolution level (see mps.h). */
+/* lubkit MPS: one semi-implicit MPS step for one resolution level (see mps.h): the steps of
+ * the method (methods.md §2).  The models act through lub_mps.hooks (forces, after the
+ * correction) and the given particles (lub_mps.fixed, .inside); the walls' checks are
+ * mps/walls.c. */
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -36,7 +39,7 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
     m->dim = P->dim;
     if (P->nlevels > 1)
         lub_bug("lub_mps_init: the particles have %d resolution levels; a solver takes one "
-                "(multi-resolution: one solver per level, mps/opt.h)",
+                "(multi-resolution: one solver per level, models/multiResolution/opt.h)",
                 P->nlevels);
     m->l0 = P->levels[0].l0;
     if (!(m->l0 > 0)) lub_fatal("particle file has no valid l0 for level 0");
@@ -173,6 +176,11 @@ static void neighbours(lub_mps *m, int rebuild)
         m->st.nrebuild++;
     }
     lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
+}
+
+void lub_mps_relist(lub_mps *m)
+{
+    neighbours(m, 1);
 }
 
 /* Pass 1 of the CSR assembly of an MPS matrix over the unknowns prow[0..nrows): row r has
@@ -323,12 +331,12 @@ static lub_solve_status lsmps_solve(lub_mps *m, lub_linsolver *s, int nrhs, doub
     return worst;
 }
 
-static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
+/* g: the body acceleration of the step, body: whether there is one (lub_mps_step) */
+static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg, size_t msgsize)
 {
     lub_particles *P = m->P;
     const size_t n = P->n;
     const int dim = m->dim;
-    const double *g = m->c.g;
     /* a fixed-band particle (m->fixed) keeps its given velocity: u* = u, a Dirichlet value */
     const uint8_t *fix = m->fixed;
     lub_timer_start(&m->tm, LUB_T_VISCOSITY);
@@ -340,7 +348,7 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
     if (gold) smooth_fluid(m, m->gbar, m->grad);
     if (m->c.viscosity == LUB_VISCOSITY_EXPLICIT) {
         /* (T-3, T-7) with the dummy particles' ghost velocity (see dummy_velocity) */
-        const double cl = 2.0 * dim / (m->lambda0 * m->n0), nu = m->c.nu;
+        const double cl = lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, 1.0), nu = m->c.nu;
         const lub_neighbours *nb = &m->nb;
         const double gm = m->c.mirror_dummies ? 2.0 : 1.0;
 #pragma omp parallel for schedule(static)
@@ -360,7 +368,7 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
         /* (T-31): u*_i - (dt nu/2) <lap u*>_i = u_i + (dt nu/2) <lap u^k>_i + dt g, with the
          * wall, dummy (and fixed-band) velocities known.  Rows: the other fluid particles;
          * symmetric since w_ij is. */
-        const double k = 0.5 * dt * m->c.nu * 2.0 * dim / (m->lambda0 * m->n0);
+        const double k = lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, 0.5 * dt * m->c.nu);
         const lub_neighbours *nb = &m->nb;
         const double gm = m->c.mirror_dummies ? 2.0 : 1.0;
         int nf = 0;
@@ -468,7 +476,7 @@ static int viscosity(lub_mps *m, double dt, char *msg, size_t msgsize)
         for (int d = 0; d < dim; d++)
 #pragma omp parallel for schedule(static)
             for (int r = 0; r < nf; r++) m->us[d][m->prow[r]] = m->xv[d][r];
-    } else if (m->c.gravity || rinv != 0.0) {
+    } else if (body || rinv != 0.0) {
         for (int d = 0; d < dim; d++)
 #pragma omp parallel for schedule(static)
             for (size_t i = 0; i < n; i++)
@@ -562,7 +570,7 @@ static int open_side(const lub_mps *m, size_t i, const double c[3], double ccos)
  *     the particle (alone: the test of the earlier builds).
  *   pnd: the PND test alone.
  *
- * In a multi-resolution overlap (m->inside, set by mps/opt.c) a particle where the other
+ * In a multi-resolution overlap (m->inside, set by models/multiResolution/opt.c) a particle where the other
  * level's particles fill the neighbourhood is not on a surface, whatever its own PND. */
 static void free_surface(lub_mps *m)
 {
@@ -678,7 +686,7 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
     lub_particles *P = m->P;
     const lub_neighbours *nb = &m->nb;
     const size_t n = P->n;
-    const double c = 2.0 * m->dim / (m->lambda0 * m->n0);
+    const double c = lub_mps_laplacian_coefficient(m->dim, m->lambda0, m->n0, 1.0);
     const double src = m->c.gamma * m->c.rho / (dt * dt) / m->n0;
     const double alpha = m->c.alpha;
     /* multi-resolution fixed band: the given pressure P->p of a fixed particle is a Dirichlet
@@ -852,52 +860,6 @@ assemble:
     return 0;
 }
 
-/* Collision (methods.md §2 step 7): a fluid particle closer than the collision distance to
- * another particle and approaching it loses the approaching part of the relative normal
- * velocity, with restitution e: half of (1 + e) of it against a fluid particle (equal
- * masses), all of it against a wall or dummy particle (infinite mass).  Each particle's
- * change is computed from the velocities before the collision step, so the result does not
- * depend on the order or the number of threads.  The pairs are those of the lists at r*
- * (lub_mps_step checks that they are complete), at the current positions. */
-static void collision(lub_mps *m, double dt)
-{
-    lub_particles *P = m->P;
-    const lub_neighbours *nb = &m->nb;
-    const size_t n = P->n;
-    const double dc = m->c.collision_distance * m->l0, e = m->c.restitution;
-    double *du[3] = {m->grad[0], m->grad[1], m->grad[2]};
-    double *x[3] = {P->x[0], P->x[1], P->x[2]};
-#pragma omp parallel for schedule(static)
-    for (size_t i = 0; i < n; i++) {
-        double acc[3] = {0, 0, 0};
-        /* a fixed-band particle keeps its given velocity (it still stops the others) */
-        if (P->kind[i] == LUB_FLUID && !(m->fixed && m->fixed[i])) {
-            for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
-                const size_t j = nb->j[q];
-                double v[3];
-                const double r2 = lub_neighbours_r(nb, x, i, j, v); /* now, not at the build */
-                if (r2 >= dc * dc || r2 <= 0) continue;
-                const double r = sqrt(r2);
-                double vn = 0, ev[3] = {0, 0, 0};
-                for (int d = 0; d < m->dim; d++) {
-                    ev[d] = v[d] / r;
-                    vn += (P->u[d][i] - P->u[d][j]) * ev[d];
-                }
-                if (vn <= 0) continue; /* separating */
-                double f = P->kind[j] == LUB_FLUID ? 0.5 * (1 + e) : (1 + e);
-                for (int d = 0; d < m->dim; d++) acc[d] -= f * vn * ev[d];
-            }
-        }
-        for (int d = 0; d < 3; d++) du[d][i] = acc[d];
-    }
-    for (int d = 0; d < m->dim; d++)
-#pragma omp parallel for schedule(static)
-        for (size_t i = 0; i < n; i++) {
-            P->u[d][i] += du[d][i];
-            P->x[d][i] += du[d][i] * dt;
-        }
-}
-
 /* Wrap periodic coordinates into [lo, hi). */
 static void wrap(lub_mps *m)
 {
@@ -915,316 +877,6 @@ static void wrap(lub_mps *m)
             }
         }
     }
-}
-
-static const char *kind_name(int k)
-{
-    return k == LUB_FLUID ? "fluid" : k == LUB_WALL ? "wall" : "dummy";
-}
-
-/* Through a wall.  Walls are one layer of wall particles on the surface with dummy layers
- * l0, 2 l0 ... behind it (particleGen: along the normal for planes and polylines, filling the
- * corners on the lattice; arcs, rings and spheres sample every layer with its own spacing of
- * about l0, so that a dummy is in general not straight behind a wall particle).  Walls move
- * and deform (movingWalls, elasticWall), so the test is made on the particles, not on the
- * geometry.  A fluid particle i went through a wall in the step when, relative to the wall
- * particles around it, it moved from in front of the wall layer to behind it.  With the wall
- * and dummy particles of one patch among i's neighbours (within re):
- *
- *   n     the wall's normal at i, into the fluid: normal to the least-squares line (plane in
- *         3-D) through the wall particles, oriented from the centroid of the dummy particles
- *         to that of the wall particles;
- *   w     the wall particle nearest to the line through i along n: it must be within
- *         0.55 l0 of that line (0.75 l0 in 3-D), and the wall layer must go on at least
- *         l0/4 beyond i on both sides (across n; in 3-D in both tangent directions);
- *   t     the depth of i behind the wall layer, n.(r_w - r_i): t1 now, and t0 = t1 -
- *         dt n.(u_w - u_i) before the step (each particle moved by u dt in it: wall and
- *         dummy particles in step 3, fluid particles in steps 3 and 8 and in the collision);
- *
- * i went through the wall of the patch when t0 <= l0/4 < t1.  The distances, in l0, for a
- * wall layer of spacing s <= l0 (elasticWall stretches it by far less than 1%):
- *   - fluid sliding along the wall sits ~1 in front of the wall layer (t ~ -1), ~2 from the
- *     first dummy layer; a particle pushed against the wall layer by the collision model is
- *     still in front of it (t <= 0, the line through the centres of the wall particles) and
- *     is never flagged; t1 > 1/4 is a quarter spacing into the wall, where the nearest dummy
- *     is at most sqrt(0.55^2 + 0.75^2) = 0.93 away (1.06 in 3-D);
- *   - n is exact on a plane (the adjugate of the wall particles' covariance, of rank d - 1
- *     there, is a multiple of n n^T) and within about l0 / (2 R) radians of it on an arc of
- *     radius R; the centroids alone would tilt it by up to 20 degrees (27 at re = 1.5 l0),
- *     as the layers are cut off at re at different places.  Across n the wall particles
- *     are at most s apart, so one is within s/2 (s/sqrt(2) on a square lattice) of the
- *     line through i: the bounds 0.55 and 0.75 leave 10% for rings sampled slightly wider
- *     than l0;
- *   - the test looks at the motion, not only at the position, because the oil can reach
- *     the dummy particles without crossing the wall layer: round the open end of a wall,
- *     where its dummy layers end (a wall with a range; an arc that does not close over a
- *     periodic seam).  In the soft-EHL tutorial (tutorials/softEHL/cylinderFlatReduced)
- *     from step 360 on a few particles flow round the end of the cylinder's arc at x = 0.4
- *     mm into its dummy layers and stay there, up to 3 l0 deep and 0.04 l0 from a dummy
- *     particle.  They are not flagged: beside the end of the wall layer the line or the
- *     both-sides test fails, and once behind it they keep t >= 0.64 (measured over the
- *     1,200 steps), clear of l0/4.  A test on the position alone (i nearer a dummy than any
- *     wall particle, say) stops that tutorial at step 364.
- * Not seen: a particle that goes through all the layers within one step (the box check stops
- * the run when it leaves the domain, as in the wedge at Courant 1: tutorials/README.md),
- * one within l0/4 of the open end of a wall, and one where two patches meet, since each
- * patch is looked at alone.
- *
- * Cost.  The search starts from the dummy particles: only a fluid particle closer than
- * 1.2 l0 to one is tested, over its own list.  In a sound run there is none (the first dummy
- * layer is ~2 from the fluid; measured in every test and tutorial but the soft-EHL one:
- * 1.1 l0 at the closest), so the check costs a sweep over the lists of the dummy particles.
- * No list is built for it: the lists are those of the last update (at r*, or before the
- * collision step); since then only fluid particles have moved, by their pressure correction
- * (and collision) delta, and every pair closer than re was listed, so every pair now closer
- * than 1.2 l0 is, as long as delta < re - 1.2 l0 (1.9 l0 at the default re = 3.1 l0).  The
- * distances are taken at the current positions (lub_neighbours_r).  A particle moving
- * further in one step (a run already diverging) is seen with the next step's lists if it is
- * still near a dummy particle. */
-#define THROUGH_GATE  1.2  /* l0: fluid particles this close to a dummy particle are tested */
-#define THROUGH_DEPTH 0.25 /* l0: t0 <= THROUGH_DEPTH < t1; also the both-sides margin */
-
-/* Fluid particle i and the wall of patch `patch`: the depths t0, t1 (m) and whether i went
- * through the wall layer in the step (dt). */
-static int through(const lub_mps *m, double dt, size_t i, unsigned patch, double *t0, double *t1)
-{
-    const lub_particles *P = m->P;
-    const lub_neighbours *nb = &m->nb;
-    double *const x[3] = {P->x[0], P->x[1], P->x[2]};
-    const int dim = m->dim;
-    const double re2 = m->re * m->re, l0 = m->l0;
-    /* centroids of the patch's wall and dummy neighbours, covariance of the wall particles */
-    double cw[3] = {0, 0, 0}, cd[3] = {0, 0, 0}, S[3][3] = {{0}};
-    int nw = 0, nd = 0;
-    for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
-        const size_t j = nb->j[q];
-        if (P->kind[j] == LUB_FLUID || P->patch[j] != patch) continue;
-        double v[3];
-        if (!(lub_neighbours_r(nb, x, i, j, v) < re2)) continue;
-        if (P->kind[j] == LUB_WALL) {
-            for (int a = 0; a < 3; a++) {
-                cw[a] += v[a];
-                for (int b = 0; b < 3; b++) S[a][b] += v[a] * v[b];
-            }
-            nw++;
-        } else {
-            for (int a = 0; a < 3; a++) cd[a] += v[a];
-            nd++;
-        }
-    }
-    if (nw < 2 || !nd) return 0;
-    double n0[3], C[3][3], A[3][3] = {{0}}, n[3] = {0, 0, 0}, nn = 0, n0n = 0, tr = 0;
-    for (int a = 0; a < 3; a++) {
-        cw[a] /= nw;
-        n0[a] = cw[a] - cd[a] / nd;
-        n0n += n0[a] * n0[a];
-    }
-    for (int a = 0; a < 3; a++)
-        for (int b = 0; b < 3; b++) C[a][b] = S[a][b] / nw - cw[a] * cw[b];
-    /* adjugate of the covariance: for wall particles on a line (plane in 3-D) it has rank
-     * dim - 1 and the adjugate is a multiple of n n^T */
-    if (dim == 2) {
-        A[0][0] = C[1][1], A[1][1] = C[0][0], A[0][1] = A[1][0] = -C[0][1];
-        tr = C[0][0] + C[1][1];
-    } else {
-        A[0][0] = C[1][1] * C[2][2] - C[1][2] * C[1][2];
-        A[1][1] = C[0][0] * C[2][2] - C[0][2] * C[0][2];
-        A[2][2] = C[0][0] * C[1][1] - C[0][1] * C[0][1];
-        A[0][1] = A[1][0] = C[0][2] * C[1][2] - C[0][1] * C[2][2];
-        A[0][2] = A[2][0] = C[0][1] * C[1][2] - C[0][2] * C[1][1];
-        A[1][2] = A[2][1] = C[0][1] * C[0][2] - C[0][0] * C[1][2];
-        tr = C[0][0] + C[1][1] + C[2][2];
-        tr *= tr;
-    }
-    for (int a = 0; a < 3; a++)
-        for (int b = 0; b < 3; b++) n[a] += A[a][b] * n0[b];
-    for (int a = 0; a < 3; a++) nn += n[a] * n[a];
-    /* the wall particles all on one line (3-D) or one point: the centroids' direction */
-    if (!(nn > 1e-12 * tr * tr * n0n)) {
-        for (int a = 0; a < 3; a++) n[a] = n0[a];
-        nn = n0n;
-    }
-    if (!(nn > 0)) return 0;
-    const double sn = (n[0] * n0[0] + n[1] * n0[1] + n[2] * n0[2] < 0 ? -1 : 1) / sqrt(nn);
-    for (int a = 0; a < 3; a++) n[a] *= sn;
-    /* tangent directions e[0] (2-D); e[0], e[1] (3-D: e[0] = n x the axis least aligned
-     * with n, e[1] = n x e[0]) */
-    double e[2][3] = {{-n[1], n[0], 0}, {0, 0, 0}};
-    if (dim == 3) {
-        const int k = fabs(n[0]) <= fabs(n[1]) && fabs(n[0]) <= fabs(n[2]) ? 0
-                      : fabs(n[1]) <= fabs(n[2])                           ? 1
-                                                                           : 2;
-        double ax[3] = {0, 0, 0}, ee = 0;
-        ax[k] = 1;
-        e[0][0] = n[1] * ax[2] - n[2] * ax[1];
-        e[0][1] = n[2] * ax[0] - n[0] * ax[2];
-        e[0][2] = n[0] * ax[1] - n[1] * ax[0];
-        for (int a = 0; a < 3; a++) ee += e[0][a] * e[0][a];
-        for (int a = 0; a < 3; a++) e[0][a] /= sqrt(ee);
-        e[1][0] = n[1] * e[0][2] - n[2] * e[0][1];
-        e[1][1] = n[2] * e[0][0] - n[0] * e[0][2];
-        e[1][2] = n[0] * e[0][1] - n[1] * e[0][0];
-    }
-    /* w: the wall particle nearest to the line through i along n; the wall layer on both
-     * sides */
-    const int nt = dim - 1, all = (1 << (2 * nt)) - 1;
-    const double side = THROUGH_DEPTH * l0, band = (dim == 3 ? 0.75 : 0.55) * l0;
-    int sides = 0;
-    size_t w = i;
-    double lw2 = INFINITY, tw = 0;
-    for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
-        const size_t j = nb->j[q];
-        if (P->kind[j] != LUB_WALL || P->patch[j] != patch) continue;
-        double v[3];
-        const double r2 = lub_neighbours_r(nb, x, i, j, v);
-        if (!(r2 < re2)) continue;
-        const double t = v[0] * n[0] + v[1] * n[1] + v[2] * n[2];
-        if (r2 - t * t < lw2) lw2 = r2 - t * t, w = j, tw = t;
-        for (int k = 0; k < nt; k++) {
-            const double p = v[0] * e[k][0] + v[1] * e[k][1] + v[2] * e[k][2];
-            if (p >= side) sides |= 1 << (2 * k);
-            if (p <= -side) sides |= 1 << (2 * k + 1);
-        }
-    }
-    if (w == i || sides != all || !(lw2 <= band * band)) return 0;
-    double du = 0;
-    for (int a = 0; a < dim; a++) du += n[a] * (P->u[a][w] - P->u[a][i]);
-    *t1 = tw;
-    *t0 = tw - dt * du;
-    return *t0 <= THROUGH_DEPTH * l0 && *t1 > THROUGH_DEPTH * l0;
-}
-
-/* The first (lowest index) fluid particle that went through a wall in the step, or -1; the
- * patch and depths of its crossing. */
-static long through_wall(const lub_mps *m, double dt, unsigned *patch, double *t0, double *t1)
-{
-    const lub_particles *P = m->P;
-    const lub_neighbours *nb = &m->nb;
-    double *const x[3] = {P->x[0], P->x[1], P->x[2]};
-    const double g2 = THROUGH_GATE * THROUGH_GATE * m->l0 * m->l0;
-    const long none = (long)P->n;
-    long first = none;
-    /* from the fluid side (the dummies have no lists of their own): each fluid particle near
-     * a dummy of a patch, tested against that patch */
-#pragma omp parallel for schedule(static) reduction(min : first)
-    for (size_t i = 0; i < P->n; i++) {
-        if (P->kind[i] != LUB_FLUID || (long)i >= first) continue;
-        if (m->fixed && m->fixed[i]) continue; /* given: lub_mps_buried */
-        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
-            const size_t d = nb->j[q];
-            if (P->kind[d] != LUB_DUMMY) continue;
-            if (!(lub_neighbours_r(nb, x, d, i, NULL) < g2)) continue;
-            double a, b;
-            if (through(m, dt, i, P->patch[d], &a, &b)) {
-                first = (long)i;
-                break;
-            }
-        }
-    }
-    if (first == none) return -1;
-    /* the patch of the crossing (the first in patch order when several) */
-    for (unsigned k = 0; k < (unsigned)P->npatches; k++)
-        if (through(m, dt, (size_t)first, k, t0, t1)) {
-            *patch = k;
-            break;
-        }
-    return first;
-}
-
-size_t lub_mps_buried(const lub_mps *m, double dt, uint8_t *flag)
-{
-    const lub_particles *P = m->P;
-    const lub_neighbours *nb = &m->nb;
-    double *const x[3] = {P->x[0], P->x[1], P->x[2]};
-    const double g2 = THROUGH_GATE * THROUGH_GATE * m->l0 * m->l0;
-    memset(flag, 0, P->n);
-    if (!m->fixed) return 0;
-    size_t n = 0;
-    /* from the fluid side (the dummies have no lists of their own) */
-#pragma omp parallel for schedule(static) reduction(+ : n)
-    for (size_t i = 0; i < P->n; i++) {
-        if (P->kind[i] != LUB_FLUID || !m->fixed[i]) continue;
-        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
-            const size_t d = nb->j[q];
-            if (P->kind[d] != LUB_DUMMY) continue;
-            if (!(lub_neighbours_r(nb, x, d, i, NULL) < g2)) continue;
-            double a = 0, b = 0;
-            through(m, dt, i, P->patch[d], &a, &b);
-            if (b > THROUGH_DEPTH * m->l0) {
-                flag[i] = 1, n++;
-                break;
-            }
-        }
-    }
-    return n;
-}
-
-lub_step_status lub_mps_check(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize)
-{
-    lub_particles *P = m->P;
-    *bad = -1;
-    msg[0] = '\0';
-    for (size_t i = 0; i < P->n; i++) {
-        int finite = isfinite(P->p[i]);
-        for (int d = 0; d < m->dim; d++) finite &= isfinite(P->x[d][i]) && isfinite(P->u[d][i]);
-        if (!finite) {
-            *bad = (long)i;
-            snprintf(msg, msgsize,
-                     "non-finite value at %s particle id %llu: position (%g, %g), velocity "
-                     "(%g, %g), pressure %g",
-                     kind_name(P->kind[i]), (unsigned long long)P->id[i], P->x[0][i], P->x[1][i],
-                     P->u[0][i], P->u[1][i], P->p[i]);
-            return LUB_STEP_NONFINITE;
-        }
-        for (int d = 0; d < m->dim; d++) {
-            if (m->periodic[d]) continue;
-            if (P->x[d][i] < m->lo[d] || P->x[d][i] > m->hi[d]) {
-                *bad = (long)i;
-                snprintf(msg, msgsize,
-                         "%s particle id %llu left the domain: %c = %g outside [%g, %g] "
-                         "(velocity %g, %g)",
-                         kind_name(P->kind[i]), (unsigned long long)P->id[i], "xyz"[d],
-                         P -> x[d][i], m -> lo[d], m -> hi[d], P -> u[0][i], P -> u[1][i]);
-                return LUB_STEP_ESCAPED;
-            }
-        }
-    }
-    unsigned patch = 0;
-    double t0 = 0, t1 = 0;
-    long b = through_wall(m, dt, &patch, &t0, &t1);
-    if (b >= 0) {
-        const size_t i = (size_t)b;
-        char pos[96], vel[96];
-        if (m->dim == 3) {
-            snprintf(pos, sizeof pos, "%g, %g, %g", P->x[0][i], P->x[1][i], P->x[2][i]);
-            snprintf(vel, sizeof vel, "%g, %g, %g", P->u[0][i], P->u[1][i], P->u[2][i]);
-        } else {
-            snprintf(pos, sizeof pos, "%g, %g", P->x[0][i], P->x[1][i]);
-            snprintf(vel, sizeof vel, "%g, %g", P->u[0][i], P->u[1][i]);
-        }
-        *bad = b;
-        snprintf(msg, msgsize,
-                 "fluid particle id %llu went through the wall '%s': position (%s), velocity "
-                 "(%s), %.2g l0 behind its wall layer (%.2g l0 %s it before the step)",
-                 (unsigned long long)P->id[i],
-                 patch < (unsigned)P->npatches ? P->patch_names[patch] : "?", pos, vel, t1 / m->l0,
-                 fabs(t0) / m->l0, t0 <= 0 ? "in front of" : "behind");
-        return LUB_STEP_ESCAPED;
-    }
-    return LUB_STEP_OK;
-}
-
-double lub_mps_max_speed(const lub_mps *m)
-{
-    const lub_particles *P = m->P;
-    double u2 = 0;
-#pragma omp parallel for schedule(static) reduction(max : u2)
-    for (size_t i = 0; i < P->n; i++) {
-        double s = 0;
-        for (int d = 0; d < m->dim; d++) s += P->u[d][i] * P->u[d][i];
-        if (s > u2) u2 = s;
-    }
-    return sqrt(u2);
 }
 
 lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize)
@@ -1254,8 +906,11 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
             for (int d = 0; d < dim; d++) P->u[d][i] = m->c.patch_velocity[P->patch[i]][d];
     neighbours(m, rebuild);
 
-    /* 2. viscosity and body force */
-    if (viscosity(m, dt, msg, msgsize)) return LUB_STEP_SOLVE_FAILED;
+    /* 2. viscosity and body force (the configuration's g and the models': gravity) */
+    double g[3] = {m->c.g[0], m->c.g[1], m->c.g[2]};
+    int body = m->c.gravity;
+    if (m->hooks.forces && m->hooks.forces(m->hooks.ctx, m, dt, g)) body = 1;
+    if (viscosity(m, dt, g, body, msg, msgsize)) return LUB_STEP_SOLVE_FAILED;
 
     /* 3. temporary positions (T-8); with still_walls only the fluid moves (the walls are at
      * rest or slide along themselves: their particles carry the velocity in place), and the
@@ -1316,25 +971,15 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     }
     lub_timer_stop(&m->tm, LUB_T_GRADIENT);
 
-    /* 9. collision, periodic wrap, checks */
-    if (m->c.collision) {
-        /* the lists of r* hold every pair now closer than the collision distance while no
-         * particle moved (r* to now: the correction) more than half their difference */
-        lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
-        double *x[3] = {P->x[0], P->x[1], P->x[2]};
-        const double lim = 0.5 * (m->re - m->c.collision_distance * m->l0);
-        const int rebuild = lub_neighbours_moved(&m->nb, x, lim) != 0;
-        lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
-        if (rebuild) neighbours(m, 1);
-        lub_timer_start(&m->tm, LUB_T_OTHER);
-        collision(m, dt);
-        lub_timer_stop(&m->tm, LUB_T_OTHER);
-    }
+    /* 9. the models' corrections (collision), periodic wrap, checks */
+    if (m->hooks.after_correction) m->hooks.after_correction(m->hooks.ctx, m, dt);
     lub_timer_start(&m->tm, LUB_T_OTHER);
     wrap(m);
     lub_step_status s = lub_mps_check(m, dt, bad, msg, msgsize);
     m->st.umax = lub_mps_max_speed(m);
     lub_timer_stop(&m->tm, LUB_T_OTHER);
+    m->iterations[0] += m->st.p.iterations;
+    for (int d = 0; d < dim; d++) m->iterations[1] += m->st.v[d].iterations;
     m->steps++;
     return s;
 }

@@ -8,7 +8,7 @@
 
 #include "core/error.h"
 #include "io/dict.h"
-#include "mps/weight.h"
+#include "particles/weight.h"
 
 #ifndef M_PI
 #define M_PI 3.14159265358979323846

@@ -19,7 +19,8 @@ static int curve_cmp(const void *a, const void *b)
     return (u->id > v->id) - (u->id < v->id);
 }
 
-/* particleGen's owner of x (geometry.h levels; mps/levels.h lub_levels_locate) */
+/* particleGen's owner of x (geometry.h levels; models/multiResolution/levels.h lub_levels_locate)
+ */
 static int owner(const lub_geometry *g, double x)
 {
     for (int k = 0; k < g->nlevels - 1; k++)

@@ -8,16 +8,16 @@
  *
  * over its wall particles sorted by x, w_k the segment widths of lub_elastic_segment_widths
  * (half-way to each neighbour), exactly the sum the elasticWall model balances against its
- * load (mps/elastic_wall.h).
+ * load (models/elasticWall/elasticWall.h).
  *
  * Multi-resolution (particles of several levels, and the geometry g of
  * system/particleGenDict.yaml with the same levels): every level has its own wall particles
  * in the overlaps, so the curve is made of the wall particles in the part of x their level
  * owns (particleGen's ownership: the first level whose region holds x, else the last; as
- * mps/levels.h), each point of x once, as the elasticWall model counts its load.  Without g
- * (or with a single level) every wall particle of the patch is on the curve.
+ * models/multiResolution/levels.h), each point of x once, as the elasticWall model counts its load.
+ * Without g (or with a single level) every wall particle of the patch is on the curve.
  *
- * The elastic wall (models/elastic.h, mps/elastic_wall.h) puts wall particle k at
+ * The elastic wall (models/elastic.h, models/elasticWall/elasticWall.h) puts wall particle k at
  *
  *     y_k = y_f + h0 + s_k + v_k                                                    (T-50)
  *

@@ -29,6 +29,7 @@
 #include "geometry/geometry.h"
 #include "io/case.h"
 #include "io/table.h"
+#include "models/collision/collision.h"
 #include "mps/mps.h"
 #include <stdio.h>
 #include <string.h>
@@ -80,9 +81,10 @@ static int report(double across)
     c.viscosity = LUB_VISCOSITY_CN;
     c.gravity = 1;
     c.g[1] = -g;
-    c.collision = 1;
     lub_mps m;
     lub_mps_init(&m, &P, &c, geo.dmin, geo.dmax, geo.periodic);
+    const lub_collision col = lub_collision_defaults();
+    lub_collision_attach(&m, &col);
 
     char data[LUB_PATH_MAX];
     const char *top = getenv("LUB_TOP");

@@ -6,7 +6,7 @@
  *
  * Not built by the Makefile; compile with
  *     cc -std=c11 -O2 -fopenmp -Isrc tests/bench/neighbours_bench.c src/mps/neighbours.c \
- *        src/mps/operators.c src/core/error.c -lm -o neighbours_bench
+ *        src/mps/operators.c src/particles/weight.c src/core/error.c -lm -o neighbours_bench
  */
 #include <math.h>
 #include <omp.h>

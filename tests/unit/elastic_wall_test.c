@@ -1,4 +1,4 @@
-/* Unit tests of src/mps/elastic_wall: the elasticWall model in the particle solver.
+/* Unit tests of src/models/elasticWall: the elasticWall model in the particle solver.
  *
  *   - the running mean: the exponential mean with a = 2/(N + 1) follows a linearly rising
  *     pressure with the lag of the box mean over the last N steps, (N - 1)/2 steps, and a
@@ -26,10 +26,10 @@
 
 #include "geometry/discretise.h"
 #include "geometry/geometry.h"
-#include "mps/elastic_wall.h"
-#include "mps/levels.h"
+#include "models/elasticWall/elasticWall.h"
+#include "models/multiResolution/levels.h"
 #include "mps/mps.h"
-#include "mps/opt.h"
+#include "models/multiResolution/opt.h"
 #include "test.h"
 
 static const char *geom_text = "dimension: 2\n"

@@ -1,4 +1,4 @@
-/* The solver's check for fluid particles going through a wall (src/mps/step.c,
+/* The solver's check for fluid particles going through a wall (src/mps/walls.c,
  * lub_mps_check): particleGen-style walls (one wall layer, two dummy layers) with a fluid
  * particle placed, and given the velocity that brought it there in a step of dt (its
  * position before the step is r - u dt), at the places the criterion must tell apart:
@@ -27,6 +27,7 @@
 #include "geometry/discretise.h"
 #include "flow.h" /* generate() */
 #include "geometry/geometry.h"
+#include "models/collision/collision.h"
 #include "mps/mps.h"
 #include "test.h"
 
@@ -38,6 +39,7 @@ typedef struct {
     lub_particles P;
     lub_geometry g;
     lub_mps m;
+    lub_collision collision; /* the collision model's defaults (scene_open) */
     double l0, dt;
 } scene;
 
@@ -46,6 +48,7 @@ typedef struct {
 static void scene_particles(scene *s, const char *dict, lub_mps_config *c)
 {
     memset(s, 0, sizeof *s);
+    s->collision = lub_collision_defaults();
     generate(dict, &s->P, &s->g);
     lub_mps_config_defaults(c);
     c->rho = 1000;
@@ -66,8 +69,8 @@ static void scene_open(scene *s, const char *dict, int collision)
     lub_mps_config c;
     scene_particles(s, dict, &c);
     c.alpha = 1e-6 / (s->P.levels[0].l0 * s->P.levels[0].l0); /* closed channels */
-    c.collision = collision;
     scene_solver(s, &c);
+    if (collision) lub_collision_attach(&s->m, &s->collision);
 }
 
 static void scene_close(scene *s)

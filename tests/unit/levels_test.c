@@ -1,6 +1,6 @@
-/* Unit tests of src/mps/levels: the multiResolution entry of constant/models.yaml, checked
- * against the levels of system/particleGenDict.yaml, and the regions of the overlapping
- * particle technique (methods.md §3; thesis §2-2).
+/* Unit tests of src/models/multiResolution/levels: the multiResolution entry of
+ * constant/models.yaml, checked against the levels of system/particleGenDict.yaml, and the regions
+ * of the overlapping particle technique (methods.md §3; thesis §2-2).
  *
  * Reference numbers, by hand, for the thesis wedge with OPT (methods.md §6.1, case 6; the
  * geometry of tutorials/wedge/cylinderFlatOPT): fine l0 = 5 um owns [a1, a2] = [-3.6, 3.0] mm,
@@ -19,7 +19,7 @@
 #include "geometry/discretise.h"
 #include "geometry/geometry.h"
 #include "io/dict.h"
-#include "mps/levels.h"
+#include "models/multiResolution/levels.h"
 #include "test.h"
 
 static char geo_path[256];

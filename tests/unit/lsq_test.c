@@ -14,7 +14,7 @@
 #include <string.h>
 
 #include "mps/lsq.h"
-#include "mps/weight.h"
+#include "particles/weight.h"
 #include "test.h"
 
 /* deterministic random numbers in [0, 1) (xorshift64*) */

@@ -21,6 +21,7 @@
 #include "flow.h"
 #include "geometry/discretise.h"
 #include "geometry/geometry.h"
+#include "models/collision/collision.h"
 #include "mps/mps.h"
 #include "test.h"
 
@@ -67,9 +68,10 @@ static void hydrostatic(const char *dict, double width, double nu, int lap)
     c.gravity = 1;
     const int up = g.dim - 1; /* gravity along the last axis */
     c.g[up] = -9.81;
-    c.collision = 1;
     lub_mps m;
     lub_mps_init(&m, &P, &c, g.dmin, g.dmax, g.periodic);
+    const lub_collision col = lub_collision_defaults();
+    lub_collision_attach(&m, &col);
     const double dt = 1e-3;
     size_t nf0 = 0;
     for (size_t i = 0; i < P.n; i++) nf0 += P.kind[i] == LUB_FLUID;

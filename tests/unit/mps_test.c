@@ -10,7 +10,7 @@
 #include "particles/particles.h"
 #include "mps/lsmps.h"
 #include "mps/operators.h"
-#include "mps/weight.h"
+#include "particles/weight.h"
 #include "test.h"
 
 /* deterministic random numbers in [0, 1) (xorshift64*) */

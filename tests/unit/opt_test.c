@@ -1,7 +1,7 @@
-/* Tests of the overlapping particle technique (src/mps/opt.h; methods.md §3, thesis §2-2):
- * two resolution levels coupled through their fixed bands, on flows with analytic solutions
- * (three levels: the test_three_* tests below).  OPT_TEST_ONLY=SUBSTRING in the environment
- * runs only the tests whose name contains it.
+/* Tests of the overlapping particle technique (src/models/multiResolution/opt.h; methods.md §3,
+ * thesis §2-2): two resolution levels coupled through their fixed bands, on flows with analytic
+ * solutions (three levels: the test_three_* tests below).  OPT_TEST_ONLY=SUBSTRING in the
+ * environment runs only the tests whose name contains it.
  *
  * The channel of mps_flow_test.c (H = 20 mm between plane walls, periodic in x), 120 mm long:
  * level 0 (l0 = 1 mm) owns x in [30, 70] mm, level 1 (l0 = 2 mm) the rest.  With the default
@@ -26,8 +26,8 @@
 
 #include "flow.h"
 #include "io/dict.h"
-#include "mps/levels.h"
-#include "mps/opt.h"
+#include "models/multiResolution/levels.h"
+#include "models/multiResolution/opt.h"
 #include "test.h"
 
 static const char *channel = "dimension: 2\n"

@@ -1,4 +1,4 @@
-/* Unit tests of src/io/particles_io.c: particle files (HDF5) and their XDMF descriptions.
+/* Unit tests of src/particles/particles_io.c: particle files (HDF5) and their XDMF descriptions.
  *
  * References are independent of the writer: round trips compare every array bit for bit
  * with what was stored in memory; damaged and foreign files are made here with the HDF5 API
@@ -20,7 +20,7 @@
 #include <hdf5.h>
 
 #include "io/case.h"
-#include "io/particles_io.h"
+#include "particles/particles_io.h"
 #include "particles/particles.h"
 #include "test.h"
 

@@ -14,7 +14,7 @@
 #include "core/args.h"
 #include "geometry/discretise.h"
 #include "io/case.h"
-#include "io/particles_io.h"
+#include "particles/particles_io.h"
 #include "particles/particles.h"
 #include "post/film.h"
 #include "post/sample.h"

@@ -15,7 +15,7 @@
 #include "geometry/discretise.h"
 #include "geometry/geometry.h"
 #include "io/case.h"
-#include "io/particles_io.h"
+#include "particles/particles_io.h"
 #include "particles/particles.h"
 
 static const char *const kind_names[] = {"fluid", "wall", "dummy"};

@@ -41,15 +41,8 @@
  *              holds one steady state.
  * The cost table (postProcessing/cost/<startTime>/cost.dat) is written by lubFoam itself.
  *
- * With the elasticWall model (constant/models.yaml) a table is always written, every
- * max(1, averageSteps / 20) steps (the running mean changes on the scale of averageSteps):
- * postProcessing/elasticWall/<startTime>/elasticWall.dat
- *     # t h0 centre load loadTarget loadTargetMean beta loadInstant vMin vMax gapMin
- * h0 the rigid-body position of T-50, centre = h0 + v(x_c), load the integral of the mean
- * wall pressure (what the load balance sees), loadTarget W(t) (T-53), loadTargetMean W(t)
- * in the same running mean (what the balance compares the load with), beta = load /
- * loadTarget - 1, loadInstant the integral of the wall pressure of the step, v the elastic
- * displacement, gapMin the smallest distance of a wall particle to the surface beneath.
+ * The models' own tables (elasticWall.dat: src/models/elasticWall/io.c) are opened and
+ * written with these (lub_scene_functions_start, lub_scene_functions_execute).
  */
 #include <dirent.h>
 #include <errno.h>
@@ -60,6 +53,7 @@
 #include "core/error.h"
 #include "io/table.h"
 #include "lubFoam.h"
+#include "models/multiResolution/levels.h"
 
 enum { FO_TOTALS, FO_WALLPRESSURE, FO_WALLLOAD };
 
@@ -81,40 +75,7 @@ typedef struct {
 struct lubfoam_functions {
     int n;
     fo *f;
-    FILE *elastic; /* elasticWall.dat */
-    long elastic_interval;
 };
-
-static void elastic_open(lubfoam_functions *F, lubfoam_run *r)
-{
-    char path[LUB_PATH_MAX];
-    lub_postproc_path(&r->cs, "elasticWall", r->start_name, "elasticWall.dat", path);
-    F->elastic = fopen(path, "w");
-    if (!F->elastic) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
-    lub_table_write_header(F->elastic, "t[s] h0[m] centre[m] load[N/m] loadTarget[N/m] "
-                                       "loadTargetMean[N/m] beta loadInstant[N/m] vMin[m] "
-                                       "vMax[m] gapMin[m]");
-    long n = r->elastic.e.average_steps / 20;
-    F->elastic_interval = n > 1 ? n : 1;
-}
-
-static void elastic_row(lubfoam_functions *F, lubfoam_run *r)
-{
-    const lub_mps_elastic *w = &r->elastic;
-    double row[11] = {r->t,
-                      w->h0,
-                      w->centre,
-                      w->load,
-                      w->load_target,
-                      w->target_mean,
-                      lub_mps_elastic_beta(w),
-                      w->load_instant,
-                      w->vmin,
-                      w->vmax,
-                      w->gap_min};
-    lub_table_write_row(F->elastic, row, 11);
-    fflush(F->elastic);
-}
 
 /* Samples line of a wallPressure p.dat: 1 and S, A, B if the file has it. */
 static int read_samples_line(const char *path, long *S, double *A, double *B)
@@ -246,12 +207,12 @@ lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
                                "function '%s': no patch '%s' in the particles (patches: %s)", name,
                                patch, list);
             }
-            o->from = lub_dict_real_or(d, "from", lubfoam_mps0(r)->lo[0], LUB_ANY);
-            o->to = lub_dict_real_or(d, "to", lubfoam_mps0(r)->hi[0], LUB_ANY);
+            o->from = lub_dict_real_or(d, "from", r->scene.level[0]->lo[0], LUB_ANY);
+            o->to = lub_dict_real_or(d, "to", r->scene.level[0]->hi[0], LUB_ANY);
             if (!(o->to > o->from))
                 lub_node_error(d, "function '%s': 'to' (%g) must be greater than 'from' (%g)", name,
                                o->to, o->from);
-            o->bin = lub_dict_real_or(d, "bin", 4 * lubfoam_mps0(r)->l0, LUB_POSITIVE);
+            o->bin = lub_dict_real_or(d, "bin", 4 * r->scene.level[0]->l0, LUB_POSITIVE);
             o->t0 = lub_dict_real_or(d, "timeStart", 0.0, LUB_NONNEGATIVE);
             o->t1 = lub_dict_real_or(d, "timeEnd", INFINITY, LUB_NONNEGATIVE);
             if (o->t1 < o->t0)
@@ -296,40 +257,43 @@ void lubfoam_functions_start(lubfoam_functions *F, lubfoam_run *r)
             wall_pressure(o, r);
         }
     }
-    if (r->has_elastic) {
-        elastic_open(F, r);
-        elastic_row(F, r);
-    }
+    lub_scene_functions_start(&r->scene, r->start_name, r->t);
 }
 
 static void totals(fo *o, lubfoam_run *r)
 {
     const lub_particles *P = &r->P;
-    double mp = r->mps.c.rho * pow(r->mps.l0, P->dim);
+    const lub_scene *sc = &r->scene;
     double mom[3] = {0, 0, 0}, ke = 0, mass = 0;
     size_t nf = 0;
-    for (size_t i = 0; i < P->n; i++) {
-        if (P->kind[i] != LUB_FLUID) continue;
-        if (r->opt) {
-            /* multi-resolution: each point of space counted on the level that owns it
-             * (T-27): the particle mass of its level times the owned part of its cell;
-             * the count is of the particles whose x their level owns */
-            const int k = P->level[i];
-            lub_level_where w;
-            lub_levels_locate(&r->opt->L, P->x[0][i], &w);
-            mp = r->opt->m[k].c.rho * pow(r->opt->m[k].l0, P->dim) *
-                 lub_levels_owned_fraction(&r->opt->L, k, P->x[0][i]);
-            if (w.owner == k) nf++;
-        } else {
+    if (sc->levels) {
+        /* resolution levels: each point of space counted on the level that owns it (T-27):
+         * the particle mass of its level times the owned part of its cell; the count is of
+         * the particles whose x their level owns (as probe totals and the mass correction) */
+        lub_levels_sums s;
+        memset(&s, 0, sizeof s);
+        lub_levels_sum(sc->levels, P, &s);
+        double m[LUB_MAX_LEVELS];
+        for (int k = 0; k < sc->nlevels; k++) {
+            m[k] = sc->level[k]->c.rho * pow(sc->level[k]->l0, P->dim);
+            nf += s.owned[k];
+            for (int d = 0; d < 3; d++) mom[d] += m[k] * s.fu[k][d];
+            ke += 0.5 * m[k] * s.fu2[k];
+        }
+        mass = lub_levels_mass(&s, sc->nlevels, m);
+    } else {
+        const double mp = sc->level[0]->c.rho * pow(sc->level[0]->l0, P->dim);
+        for (size_t i = 0; i < P->n; i++) {
+            if (P->kind[i] != LUB_FLUID) continue;
             nf++;
+            for (int d = 0; d < P->dim; d++) {
+                mom[d] += mp * P->u[d][i];
+                ke += 0.5 * mp * P->u[d][i] * P->u[d][i];
+            }
         }
-        mass += mp;
-        for (int d = 0; d < P->dim; d++) {
-            mom[d] += mp * P->u[d][i];
-            ke += 0.5 * mp * P->u[d][i] * P->u[d][i];
-        }
+        mass = mp * (double)nf;
     }
-    double row[7] = {r->t, r->opt ? mass : mp * (double)nf, mom[0], mom[1], mom[2], ke, (double)nf};
+    double row[7] = {r->t, mass, mom[0], mom[1], mom[2], ke, (double)nf};
     lub_table_write_row(o->fp, row, 7);
     fflush(o->fp);
 }
@@ -342,11 +306,8 @@ static void wall_pressure_bin(fo *o, const lubfoam_run *r)
         if (P->kind[i] != LUB_WALL || P->patch[i] != o->patch) continue;
         double x = P->x[0][i];
         if (x < o->from || x >= o->to) continue;
-        if (r->opt) { /* multi-resolution: each x on the level that owns it */
-            lub_level_where w;
-            lub_levels_locate(&r->opt->L, x, &w);
-            if (w.owner != P->level[i]) continue;
-        }
+        /* resolution levels: each x on the level that owns it */
+        if (r->scene.nlevels > 1 && lub_scene_owner(&r->scene, x) != P->level[i]) continue;
         int b = (int)((x - o->from) / o->bin);
         if (b >= o->nbins) b = o->nbins - 1;
         o->sum[b] += P->p[i];
@@ -388,7 +349,7 @@ static void wall_load(fo *o, lubfoam_run *r)
 
 void lubfoam_functions_execute(lubfoam_functions *F, lubfoam_run *r)
 {
-    if (F->elastic && r->step % F->elastic_interval == 0) elastic_row(F, r);
+    lub_scene_functions_execute(&r->scene, r->t, r->step);
     for (int k = 0; k < F->n; k++) {
         fo *o = &F->f[k];
         if (r->step % o->interval != 0) continue;
@@ -431,7 +392,6 @@ void lubfoam_functions_write(lubfoam_functions *F, lubfoam_run *r)
 void lubfoam_functions_free(lubfoam_functions *F)
 {
     if (!F) return;
-    if (F->elastic) fclose(F->elastic);
     for (int k = 0; k < F->n; k++) {
         if (F->f[k].fp) fclose(F->f[k].fp);
         free(F->f[k].sum);

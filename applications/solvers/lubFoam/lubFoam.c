@@ -16,7 +16,7 @@
 #include "core/error.h"
 #include "core/timer.h"
 #include "geometry/geometry.h"
-#include "io/particles_io.h"
+#include "particles/particles_io.h"
 #include "io/table.h"
 #include "lubFoam.h"
 
@@ -66,19 +66,19 @@ static double fraction_done(const lubfoam_run *r, long steps_done)
  * it.  At step 0 they count like the walls (a fluid given a velocity). */
 static void check_limits(lubfoam_run *r)
 {
-    /* multi-resolution: every level takes deltaT (commonDeltaT), so the finest level has the
+    /* resolution levels: every level takes deltaT (commonDeltaT), so the finest level has the
      * largest Courant and diffusion numbers for a speed; the speed is the fastest of all */
-    const lub_mps *m = lubfoam_mps0(r);
+    const lub_scene *sc = &r->scene;
+    const lub_mps *m = sc->level[0];
     double ufluid = lub_mps_max_speed(m), uwall = 0;
-    for (int k = 1; r->opt && k < r->opt->nlevels; k++)
-        ufluid = fmax(ufluid, lub_mps_max_speed(&r->opt->m[k]));
+    for (int k = 1; k < sc->nlevels; k++) ufluid = fmax(ufluid, lub_mps_max_speed(sc->level[k]));
     /* sub-stepping: a coarser level takes dt_factor deltaT; its Courant number, over the
      * finest level's, is dt_factor l0_0 / l0_k (1 when Nr is the l0 ratio, T-19) */
     double fac = 1;
-    for (int k = 1; r->opt && k < r->opt->nlevels; k++)
-        fac = fmax(fac, (double)r->opt->L.level[k].dt_factor * m->l0 / r->opt->m[k].l0);
+    for (int k = 1; k < sc->nlevels; k++)
+        fac = fmax(fac, (double)sc->dt_factor[k] * m->l0 / sc->level[k]->l0);
     if (fac > 1)
-        lub_message("multiResolution: Nr exceeds the l0 ratio: the coarse level's Courant "
+        lub_message("Levels: the sub-steps Nr exceed the l0 ratio: the coarse level's Courant "
                     "number is %g times the fine level's (checked below)",
                     fac);
     for (int k = 0; k < r->P.npatches; k++) {
@@ -126,12 +126,9 @@ static void check_limits(lubfoam_run *r)
  * lubFoam started (-1: unknown) */
 static void print_header(const lubfoam_run *r, double average, int others_running)
 {
-    const lub_mps *m = lubfoam_mps0(r);
+    const lub_mps *m = r->scene.level[0];
     size_t cnt[3] = {0, 0, 0};
     for (size_t i = 0; i < r->P.n; i++) cnt[r->P.kind[i] < 3 ? r->P.kind[i] : 0]++;
-    char ps[256], vs[256];
-    lub_linsolver_describe(&m->psolver, ps, sizeof ps);
-    lub_linsolver_describe(&m->vsolver, vs, sizeof vs);
     lub_message("lubFoam: case %s, start time %s (step %ld), %d-D", r->cs.root, r->start_name,
                 r->step, m->dim);
     lub_message("Particles: %zu (fluid %zu, wall %zu, dummy %zu), threads %d", r->P.n, cnt[0],
@@ -144,163 +141,26 @@ static void print_header(const lubfoam_run *r, double average, int others_runnin
                     "wait for each other on shared cores can make every step several times "
                     "slower; OMP_NUM_THREADS=%d may be faster",
                     average, others_running, omp_get_num_procs(), omp_get_max_threads(), fit);
-    if (r->opt) {
-        const lub_opt *o = r->opt;
-        char desc[1024];
-        lub_levels_describe(&o->L, desc, sizeof desc);
-        lub_message("multiResolution: %s", desc);
-        for (int k = 0; k < o->nlevels; k++) {
-            const lub_mps *q = &o->m[k];
-            size_t c[3] = {0, 0, 0};
-            for (size_t i = 0; i < o->P[k].n; i++) c[o->P[k].kind[i] < 3 ? o->P[k].kind[i] : 0]++;
-            lub_message("MPS level %d: l0 %g m, re %g m (%g l0), n0 %.10g, lambda0 %.10g m^2; "
-                        "%zu particles (fluid %zu, wall %zu, dummy %zu), %zu added in its "
-                        "overlap margins; %zu generation cells, room for %zu particles",
-                        k, q->l0, q->re, q->c.re_l0, q->n0, q->lambda0, o->P[k].n, c[0], c[1], c[2],
-                        o->filled[k], o->ngen[k], o->P[k].cap);
-        }
-    } else {
-        lub_message("MPS: l0 %g m, re %g m (%g l0), n0 %.10g, lambda0 %.10g m^2", m->l0, m->re,
-                    m->c.re_l0, m->n0, m->lambda0);
-    }
-    char order[64];
-    if (m->c.reorder_interval == 1)
-        snprintf(order, sizeof order, "%s every step", m->c.order_rows ? "rows" : "cells");
-    else if (m->c.reorder_interval > 1)
-        snprintf(order, sizeof order, "%s every %d steps", m->c.order_rows ? "rows" : "cells",
-                 m->c.reorder_interval);
-    else
-        snprintf(order, sizeof order, "never");
-    lub_message("Schemes: gradient %s%s, gamma %g, alpha %g, surface beta %g, viscosity %s; "
-                "particles sorted into %s",
-                m->c.gradient == LUB_GRADIENT_LSMPS ? "lsmps" : "standard",
-                m->c.min_pressure_shift ? " (min-pressure shift)" : "", m->c.gamma, m->c.alpha,
-                m->c.beta,
-                m->c.viscosity == LUB_VISCOSITY_NONE       ? "none"
-                : m->c.viscosity == LUB_VISCOSITY_EXPLICIT ? "explicit"
-                                                           : "crankNicolson",
-                order);
-    lub_message("Solvers: p %s; U %s", ps, vs);
+    lub_scene_header_fluid(&r->scene);
     /* the models of constant/models.yaml this run has (a scene enables only those it needs) */
     char models[1024];
-    size_t len = 0;
-#define LUB_MODELS_ADD(...)                                                                        \
-    do {                                                                                           \
-        if (len < sizeof models)                                                                   \
-            len += (size_t)snprintf(models + len, sizeof models - len, __VA_ARGS__);               \
-    } while (0)
-    models[0] = '\0';
-    if (m->c.gravity) {
-        LUB_MODELS_ADD("gravity (%g", m->c.g[0]);
-        for (int d = 1; d < m->dim; d++) LUB_MODELS_ADD(", %g", m->c.g[d]);
-        LUB_MODELS_ADD(") m/s^2");
-    }
-    int moving = 0;
-    for (int k = 0; k < m->P->npatches && k < LUB_MAX_PATCHES; k++) {
-        const double *v = m->c.patch_velocity[k];
-        if (v[0] == 0 && v[1] == 0 && v[2] == 0) continue;
-        LUB_MODELS_ADD("%s%s", len ? (moving ? ", " : "; ") : "", moving ? "" : "movingWalls ");
-        LUB_MODELS_ADD("%s (%g", m->P->patch_names[k], v[0]);
-        for (int d = 1; d < m->dim; d++) LUB_MODELS_ADD(", %g", v[d]);
-        LUB_MODELS_ADD(") m/s");
-        moving++;
-    }
-    if (m->c.collision)
-        LUB_MODELS_ADD("%scollision (distance %g l0, restitution %g)", len ? "; " : "",
-                       m->c.collision_distance, m->c.restitution);
-    if (r->has_elastic) LUB_MODELS_ADD("%selasticWall", len ? "; " : "");
-    if (r->opt) LUB_MODELS_ADD("%smultiResolution", len ? "; " : "");
-#undef LUB_MODELS_ADD
+    lub_scene_describe(&r->scene, models, sizeof models);
+    const size_t len = strlen(models);
     lub_message("Models: %s", len ? models : "none (constant/models.yaml)");
-    if (r->has_elastic) {
-        const lub_mps_elastic *w = &r->elastic;
-        lub_message("elasticWall: patch %s (%d wall, %d dummy particles), E %g Pa, load %g N/m "
-                    "over rampTime %g s, b %g m, p_H %g Pa, mean of %ld steps, load balance "
-                    "alpha %g (at most %g m per step), clamp %g; h0 %.6g m, %ld samples",
-                    w->e.patch_name, w->nw, w->nd, w->e.E, w->e.load, w->e.ramp_time, w->e.b,
-                    w->e.p_hertz, w->e.average_steps, w->e.relaxation, w->e.relaxation * w->e.h0,
-                    w->e.clamp, w->h0, w->samples);
-        if (w->nlevels > 1) {
-            /* the segments of the deformation and the load: each point of x on one level */
-            char lv[128 * LUB_MAX_LEVELS];
-            size_t len = 0;
-            for (int k = 0; k < w->nlevels && len < sizeof lv; k++) {
-                int owned = 0;
-                for (int s = 0; s < w->ns; s++) owned += w->src_level[s] == k;
-                len += (size_t)snprintf(lv + len, sizeof lv - len,
-                                        "%slevel %d: %d wall, %d dummy particles, %d of them "
-                                        "pressure segments",
-                                        k ? "; " : "", k, w->lv[k].nw, w->lv[k].nd, owned);
-            }
-            lub_message("elasticWall: %s (the wall pressure where the level owns x; the "
-                        "deformation at every wall particle)",
-                        lv);
-        }
-    }
-}
-
-/* The elastic wall's load error and position, for the log. */
-static void elastic_summary(const lubfoam_run *r, char *buf, size_t size)
-{
-    buf[0] = '\0';
-    if (!r->has_elastic) return;
-    const lub_mps_elastic *w = &r->elastic;
-    snprintf(buf, size, "  load %.4g/%.4g N/m (%+.2f%%) h0 %.5g m", w->load, w->load_target,
-             100.0 * lub_mps_elastic_beta(w), w->h0);
-}
-
-/* Viscosity iterations of the last step: the sum over the velocity components (0 when the
- * viscosity is explicit or absent). */
-static int viscosity_iterations(const lub_mps *m)
-{
-    int it = 0;
-    for (int d = 0; d < m->dim; d++) it += m->st.v[d].iterations;
-    return it;
+    lub_scene_header(&r->scene);
 }
 
 static void log_line(const lubfoam_run *r, long steps_done, double wall0, double pit_sum)
 {
-    const lub_mps *m = &r->mps;
     double frac = fraction_done(r, steps_done);
     double el = lub_wtime() - wall0;
-    char eta[32], ew[128];
+    char eta[32], ew[128], fluid[256 * LUB_MAX_LEVELS];
     format_hms(frac > 0 ? el * (1 - frac) / frac : NAN, eta, sizeof eta);
-    elastic_summary(r, ew, sizeof ew);
-    if (r->opt) {
-        /* per level: pressure and viscosity iterations, surface and given (fixed-band)
-         * particles; fluid particles per level and the mass (T-27) against the start's */
-        const lub_opt *o = r->opt;
-        lub_opt_mass mc;
-        lub_opt_mass_count(o, &mc);
-        /* room for every level: its part is at most about 180 characters (the counts with 20
-         * digits), and the given-in-a-wall note 40 */
-        char lv[256 * LUB_MAX_LEVELS];
-        size_t len = 0;
-        for (int k = 0; k < o->nlevels && len < sizeof lv; k++)
-            len += (size_t)snprintf(
-                lv + len, sizeof lv - len,
-                "%sL%d p %d U %d surf %zu given %zu fluid %zu (+%zu -%zu)", k ? " | " : "", k,
-                o->m[k].st.p.iterations, viscosity_iterations(&o->m[k]), o->m[k].st.nsurface,
-                o->st.nfixed[k], mc.fluid[k], o->total_generated[k], o->total_deleted[k]);
-        for (int k = 0; k < o->nlevels && len < sizeof lv; k++)
-            if (o->total_buried[k])
-                len += (size_t)snprintf(lv + len, sizeof lv - len, " | L%d given in a wall %zu", k,
-                                        o->total_buried[k]);
-        char corr[64] = "";
-        if (o->L.mass_correction)
-            snprintf(corr, sizeof corr, " (correction %+.3g m/s)", o->st.correction);
-        lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g %s  mass %+.3f%%%s  "
-                    "(p it per step, all levels: %.1f)  ETA %s%s",
-                    r->t, 100 * frac, r->step, r->dt, lub_opt_courant_per_dt(o, NULL) * r->dt, lv,
-                    r->mass0 > 0 ? 100 * (mc.mass / r->mass0 - 1) : 0.0, corr,
-                    steps_done ? pit_sum / (double)steps_done : 0.0, eta, ew);
-        return;
-    }
-    lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g p %3d it %8.2e (mean %.1f)  "
-                "U %3d it  surf %-6zu ETA %s%s",
-                r->t, 100 * frac, r->step, r->dt, m->st.umax * r->dt / m->l0, m->st.p.iterations,
-                m->st.p.residual, steps_done ? pit_sum / (double)steps_done : 0.0,
-                viscosity_iterations(m), m->st.nsurface, eta, ew);
+    lub_scene_log(&r->scene, ew, sizeof ew);
+    lub_scene_log_fluid(&r->scene, r->dt, steps_done ? pit_sum / (double)steps_done : 0.0, fluid,
+                        sizeof fluid);
+    lub_message("t %-12.6g %5.1f%%  step %-8ld dt %-9.3g Co %-6.3g %sETA %s%s", r->t, 100 * frac,
+                r->step, r->dt, lub_scene_courant(&r->scene, r->dt, NULL), fluid, eta, ew);
 }
 
 static void progress_bar(const lubfoam_run *r, long steps_done, double wall0)
@@ -317,19 +177,18 @@ static void progress_bar(const lubfoam_run *r, long steps_done, double wall0)
     fflush(stdout);
 }
 
-/* Seconds spent in phase k (multi-resolution: summed over the levels). */
+/* Seconds spent in phase k (summed over the levels). */
 static double phase_seconds(const lubfoam_run *r, int k)
 {
-    if (!r->opt) return r->mps.tm.seconds[k];
     double s = 0;
-    for (int l = 0; l < r->opt->nlevels; l++) s += r->opt->m[l].tm.seconds[k];
+    for (int l = 0; l < r->scene.nlevels; l++) s += r->scene.level[l]->tm.seconds[k];
     return s;
 }
 
 /* The timers the solver's own work outside a step (output, coupling) is charged to. */
 static lub_timers *run_timers(lubfoam_run *r)
 {
-    return r->opt ? &r->opt->m[0].tm : &r->mps.tm;
+    return &r->scene.level[0]->tm;
 }
 
 /* Cost summary on the log and in postProcessing/cost/<startTime>/cost.dat. */
@@ -391,8 +250,8 @@ int main(int argc, char **argv)
         .dictionaries = "system/controlDict.yaml\nsystem/particleGenDict.yaml (domain)\n"
                         "system/schemes.yaml\nsystem/solution.yaml (optional)\n"
                         "constant/transportProperties.yaml\nconstant/models.yaml\n"
-                        "system/reynoldsRefDict.yaml (optional: multiResolution start-up "
-                        "check)",
+                        "system/reynoldsRefDict.yaml (optional: the start-up check of "
+                        "resolution levels)",
         .has_case = 1,
         .min_args = 0,
         .max_args = 0,
@@ -416,36 +275,21 @@ int main(int argc, char **argv)
     if (r.P.dim != geo.dim)
         lub_fatal("the particles are %d-D but system/particleGenDict.yaml says dimension %d",
                   r.P.dim, geo.dim);
+    /* the fluid and the models the scene lists, and the solvers they need */
     lub_mps_config cfg;
-    lub_levels levels;
-    lub_mps_config_read(&cfg, r.cs.root, &r.P, &levels);
-    if (levels.nlevels > 0) {
-        /* multi-resolution: one solver per level (mps/opt.h); r.P keeps all levels, merged
-         * back after every step for the function objects and the time folders */
-        r.opt = lub_malloc(sizeof *r.opt);
-        lub_opt_init(r.opt, &levels, &r.P, &cfg, &geo, 0.5);
-        lubfoam_read_elastic(&r, &geo);
-        if (r.has_elastic) lub_opt_moving_wall(r.opt, &geo, r.elastic.patch);
-        lub_particles_reserve(&r.P, lub_opt_capacity(r.opt));
-        lub_opt_merge(r.opt, &r.P);
-        lub_opt_mass m0;
-        lub_opt_mass_count(r.opt, &m0);
-        r.mass0 = m0.mass;
-        if (r.has_opt_state) { /* a restart: the ids and M^0 of the run it continues */
-            if (r.next_id > r.opt->next_id) r.opt->next_id = r.next_id;
-            if (r.state_mass0 > 0) r.mass0 = r.state_mass0;
-        }
-        lub_opt_set_mass0(r.opt, r.mass0);
-    } else {
-        lub_mps_init(&r.mps, &r.P, &cfg, geo.dmin, geo.dmax, geo.periodic);
-        lubfoam_read_elastic(&r, &geo);
-    }
+    lub_scene_read(&r.scene, &r.cs, &r.P, &geo, &cfg);
+    char state[LUB_PATH_MAX], what[128];
+    lub_case_pathf(&r.cs, state, "%s/uniform/state.yaml", r.start_name);
+    snprintf(what, sizeof what, "endTime %g of system/controlDict.yaml", r.ctl.end_time);
+    lub_scene_build(&r.scene, &cfg, state, r.ctl.stop_at == LUB_STOP_ENDTIME ? r.ctl.end_time : 0.0,
+                    what);
     lubfoam_functions *fos = lubfoam_functions_read(&r);
     lub_dict_finish(r.ctl.dict);
 
     print_header(&r, load_average, others_running);
     check_limits(&r);
     lubfoam_check_levels(&r, &geo);
+    r.scene.geo = NULL;
     lub_geometry_free(&geo);
 
     /* a finished run started again (an Allrun run twice): its dictionaries are checked, but
@@ -463,7 +307,7 @@ int main(int argc, char **argv)
      * step left a last time folder and the last samples of the function objects at several
      * times the pressure of the others.  The run ends at the first step at or after
      * endTime (lub_control_finished), and says so when that is not endTime itself. */
-    const int nr = r.opt ? r.opt->nr : 1;
+    const int nr = r.scene.nr;
     if (!nothing_to_run && r.ctl.stop_at == LUB_STOP_ENDTIME && !r.ctl.adjust_time_step) {
         const double h = nr * r.dt;
         const double k = ceil((r.ctl.end_time - 1e-3 * r.dt - r.t) / h);
@@ -481,42 +325,29 @@ int main(int argc, char **argv)
     const long step0 = r.step;
     long steps = 0, last_write_step = -1;
     double pit_sum = 0, vit_sum = 0, last_bar = 0;
-    int warned_courant = 0, warned_full = 0, warned_isolated = 0, status = LUB_EXIT_OK;
+    int warned_courant = 0, warned_isolated = 0, status = LUB_EXIT_OK;
 
-    /* multi-resolution with sub-stepping: one pass of the loop is one step of the coarsest
+    /* resolution levels with sub-stepping: one pass of the loop is one step of the coarsest
      * level, nr steps of deltaT (dt below) on the finest level (nr: the product of the Nr) */
     while (!lub_control_finished(&r.ctl, r.t, steps, r.dt)) {
-        if (r.ctl.adjust_time_step && r.opt) {
-            /* every level takes dt: the largest u_max / l0 of the levels limits it */
-            double c = lub_opt_courant_per_dt(r.opt, NULL);
-            if (c > 0) r.dt = fmin(r.ctl.max_courant / c, r.ctl.delta_t);
-        } else if (r.ctl.adjust_time_step && r.mps.st.umax > 0) {
-            double dtc = r.ctl.max_courant * r.mps.l0 / r.mps.st.umax;
+        double dtc;
+        if (r.ctl.adjust_time_step && lub_scene_dt_limit(&r.scene, r.ctl.max_courant, &dtc))
             r.dt = dtc < r.ctl.delta_t ? dtc : r.ctl.delta_t;
-        }
         long bad = -1;
         char msg[1024];
-        lub_step_status s = LUB_STEP_OK;
-        if (r.has_elastic) {
-            s = lub_mps_elastic_before(&r.elastic, r.t, r.dt, msg, sizeof msg);
-            if (s != LUB_STEP_OK) {
-                /* nothing has moved: the current state is good, keep it (unless it is the
-                 * start folder or was just written) */
-                if (tty) fputc('\n', stdout);
-                if (steps > 0 && r.step != last_write_step) {
-                    lub_timer_start(&r.mps.tm, LUB_T_OUTPUT);
-                    lubfoam_write(&r);
-                    lubfoam_functions_write(fos, &r);
-                    lub_timer_stop(&r.mps.tm, LUB_T_OUTPUT);
-                }
+        lub_step_status s = lub_scene_before_step(&r.scene, r.t, r.dt, msg, sizeof msg);
+        if (s != LUB_STEP_OK) {
+            /* nothing has moved: the current state is good, keep it (unless it is the start
+             * folder or was just written) */
+            if (tty) fputc('\n', stdout);
+            if (steps > 0 && r.step != last_write_step) {
+                lub_timer_start(run_timers(&r), LUB_T_OUTPUT);
+                lubfoam_write(&r);
+                lubfoam_functions_write(fos, &r);
+                lub_timer_stop(run_timers(&r), LUB_T_OUTPUT);
             }
         }
-        if (s == LUB_STEP_OK && r.opt) {
-            int level;
-            s = lub_opt_step(r.opt, nr * r.dt, &level, &bad, msg, sizeof msg);
-        } else if (s == LUB_STEP_OK) {
-            s = lub_mps_step(&r.mps, r.dt, &bad, msg, sizeof msg);
-        }
+        if (s == LUB_STEP_OK) s = lub_scene_advance(&r.scene, r.dt, &bad, msg, sizeof msg);
         if (s != LUB_STEP_OK) {
             if (tty) fputc('\n', stdout);
             fflush(stdout);
@@ -535,25 +366,11 @@ int main(int argc, char **argv)
             r.step++;
             steps++;
         }
-        if (r.has_elastic) lub_mps_elastic_after(&r.elastic, r.t);
-        double co, umax;
-        if (r.opt) {
-            lub_timer_start(run_timers(&r), LUB_T_OTHER);
-            lub_opt_merge(r.opt, &r.P);
-            lub_timer_stop(run_timers(&r), LUB_T_OTHER);
-            int lv;
-            co = lub_opt_courant_per_dt(r.opt, &lv) * r.dt;
-            umax = r.opt->m[lv].st.umax;
-            pit_sum += (double)r.opt->st.piter; /* every level's every step */
-            vit_sum += (double)r.opt->st.viter;
-        } else {
-            pit_sum += r.mps.st.p.iterations;
-            vit_sum += viscosity_iterations(&r.mps);
-            co = r.mps.st.umax * r.dt / r.mps.l0;
-            umax = r.mps.st.umax;
-        }
-        for (int k = 0; k < (r.opt ? r.opt->nlevels : 1) && !warned_isolated; k++) {
-            const lub_mps *mk = r.opt ? &r.opt->m[k] : &r.mps;
+        lub_scene_after_step(&r.scene, r.t);
+        lub_scene_iterations(&r.scene, &pit_sum, &vit_sum); /* every level's every step */
+        double umax, co = lub_scene_courant(&r.scene, r.dt, &umax);
+        for (int k = 0; k < r.scene.nlevels && !warned_isolated; k++) {
+            const lub_mps *mk = r.scene.level[k];
             if (mk->st.nisolated > 0) {
                 lub_warning("step %ld: %zu particle(s) squeezed into groups that touch no "
                             "surface particle (first: id %llu), where the pressure equation "
@@ -568,13 +385,7 @@ int main(int argc, char **argv)
                         r.step, co, r.ctl.max_courant, umax);
             warned_courant = 1;
         }
-        if (r.opt && r.opt->total_full > 0 && !warned_full) {
-            lub_warning("step %ld: multiResolution: a level's particle arrays are full (room "
-                        "allocated at the start): %zu particles could not be generated, so the "
-                        "fluid flowing into that level is lost",
-                        r.step, r.opt->total_full);
-            warned_full = 1;
-        }
+        lub_scene_warn(&r.scene, r.step);
         lubfoam_functions_execute(fos, &r);
         int finished = lub_control_finished(&r.ctl, r.t, steps, r.dt);
         int due = 0; /* sub-stepping: a write due at any of the pass's fine steps */
@@ -586,11 +397,7 @@ int main(int argc, char **argv)
             lubfoam_write(&r);
             lubfoam_functions_write(fos, &r);
             last_write_step = r.step;
-            /* exact restart from this folder */
-            if (r.opt)
-                lub_opt_rebuild_lists(r.opt);
-            else
-                lub_mps_rebuild_lists(&r.mps);
+            lub_scene_rebuild_lists(&r.scene); /* exact restart from this folder */
             lub_timer_stop(run_timers(&r), LUB_T_OUTPUT);
         }
         if (steps / r.ctl.log_interval != (steps - nr) / r.ctl.log_interval || finished) {
@@ -612,21 +419,9 @@ int main(int argc, char **argv)
                     "is never shortened to land on endTime)",
                     r.t, r.t - r.ctl.end_time, r.ctl.end_time);
     if (!nothing_to_run) write_cost(&r, steps, lub_wtime() - wall0, pit_sum, vit_sum);
-    if (r.has_elastic && !nothing_to_run) {
-        const lub_mps_elastic *w = &r.elastic;
-        lub_message("elasticWall: t %.9g s: mean load %.6g N/m of %.6g (%+.3f%%), h0 %.9g m, "
-                    "centre %.9g m, v in [%.6g, %.6g] m, closest approach %.6g m",
-                    r.t, w->load, w->load_target, 100.0 * lub_mps_elastic_beta(w), w->h0, w->centre,
-                    w->vmin, w->vmax, w->gap_min);
-    }
+    if (!nothing_to_run) lub_scene_summary(&r.scene, r.t);
     lubfoam_functions_free(fos);
-    lub_mps_elastic_free(&r.elastic);
-    if (r.opt) {
-        lub_opt_free(r.opt);
-        free(r.opt);
-    } else {
-        lub_mps_free(&r.mps);
-    }
+    lub_scene_free(&r.scene);
     lub_particles_free(&r.P);
     lub_control_free(&r.ctl);
     free(r.written);

@@ -7,24 +7,17 @@
 #include "geometry/geometry.h"
 #include "io/case.h"
 #include "io/control.h"
-#include "mps/elastic_wall.h"
+#include "models/model.h"
 #include "mps/mps.h"
-#include "mps/opt.h"
 
 /* Run state the writers need. */
 typedef struct {
     lub_case cs;
     lub_control ctl;
-    lub_mps mps;       /* single resolution: the solver */
-    lub_opt *opt;      /* multi-resolution (constant/models.yaml multiResolution): the levels and
-                          their solvers (mps/opt.h), else NULL; mps is then unused */
-    lub_particles P;   /* the particles (multi-resolution: all levels, merged after every step) */
-    double mass0;      /* multi-resolution: the fluid mass M^0 of the run's first start (T-27) */
-    int has_opt_state; /* the start folder's uniform/state.yaml has multiResolution: */
-    unsigned long long next_id; /*   the next particle id, */
-    double state_mass0;         /*   and M^0 (an exact restart continues both) */
-    int has_elastic;            /* constant/models.yaml has elasticWall */
-    lub_mps_elastic elastic;    /* its state */
+    lub_particles P; /* the particles (with resolution levels: all levels, merged after every
+                        step by the model that solves them) */
+    lub_scene scene; /* the models of constant/models.yaml and the fluid's solvers, one per
+                        resolution level (scene.level) */
     double t, dt;
     long step;
     double start_time;
@@ -34,19 +27,8 @@ typedef struct {
     size_t nwritten, capwritten;
 } lubfoam_run;
 
-/* The solver of the finest level (the only one in a single-resolution run): its l0,
- * configuration and domain. */
-static inline const lub_mps *lubfoam_mps0(const lubfoam_run *r)
-{
-    return r->opt ? &r->opt->m[0] : &r->mps;
-}
-
 /* Start time folder per controlDict (startFrom), reading particles and uniform/state.yaml. */
 void lubfoam_read_start(lubfoam_run *r);
-/* The elasticWall model of constant/models.yaml, if any (after lub_mps_init, or lub_opt_init:
- * then on every level): its restart state from the start folder's uniform/state.yaml, the
- * ramp checked against endTime. */
-void lubfoam_read_elastic(lubfoam_run *r, const lub_geometry *geo);
 /* Write the current state as a time folder (atomic), update particles.xdmf, purge. */
 void lubfoam_write(lubfoam_run *r);
 

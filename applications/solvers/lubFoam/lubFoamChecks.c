@@ -1,7 +1,7 @@
 /* lubFoam: start-up checks of a multi-resolution case's fine/coarse boundaries (methods.md §3,
  * thesis §2-2 and case 7 of §3), printed after the Courant and diffusion numbers.  They warn
  * (stderr, "lubFoam: warning: ...") and never stop the run: a boundary in a bad place gives
- * poor results, not a failure.  For every boundary a (a1, a2 of mps/levels.h):
+ * poor results, not a failure.  For every boundary a (a1, a2 of models/multiResolution/levels.h):
  *
  *   1. the film across x = a, in coarse particles: the clearance between the walls there (or,
  *      without an upper wall, the depth of the fluid particleGen fills; lub_levels_gap)
@@ -29,6 +29,7 @@
 #include "core/timer.h"
 #include "geometry/geometry.h"
 #include "lubFoam.h"
+#include "models/multiResolution/levels.h"
 #include "reynolds/refcase.h"
 #include "reynolds/reynolds.h"
 
@@ -223,16 +224,17 @@ static void check_reynolds(const lub_levels *L, const lub_case *c)
 
 void lubfoam_check_levels(const lubfoam_run *r, const lub_geometry *geo)
 {
-    if (!r->opt) return;
+    const lub_levels *L = r->scene.levels;
+    if (!L) return;
     /* the direction the moving walls drag the oil: the mean x-velocity of the moving patches */
-    const lub_mps_config *c = &r->opt->m[0].c;
+    const lub_mps_config *c = &r->scene.level[0]->c;
     double u = 0;
     int nm = 0;
-    for (int p = 0; p < r->opt->P[0].npatches; p++) {
+    for (int p = 0; p < r->scene.level[0]->P->npatches; p++) {
         const double *v = c->patch_velocity[p];
         if (v[0] != 0 || v[1] != 0 || v[2] != 0) u += v[0], nm++;
     }
     const int inlet_side = nm == 0 || u == 0 ? -1 : u > 0 ? 0 : 1;
-    check_gaps(&r->opt->L, geo, inlet_side);
-    check_reynolds(&r->opt->L, &r->cs);
+    check_gaps(L, geo, inlet_side);
+    check_reynolds(L, &r->cs);
 }

@@ -1,4 +1,4 @@
-/* lubFoam: start time, restart state (the elastic wall's too) and time folders. */
+/* lubFoam: start time, restart state and time folders. */
 #include <errno.h>
 #include <stdlib.h>
 #include <string.h>
@@ -6,7 +6,8 @@
 
 #include "core/error.h"
 #include "io/dict.h"
-#include "io/particles_io.h"
+#include "particles/particles_io.h"
+#include "models/models.h"
 #include "lubFoam.h"
 
 static int has_particles(const lub_case *c, const char *name)
@@ -55,37 +56,12 @@ void lubfoam_read_start(lubfoam_run *r)
         r->t = lub_dict_real(root, "time", LUB_NONNEGATIVE);
         r->step = lub_dict_int(root, "step", 0, 1L << 62);
         double dt = lub_dict_real_or(root, "deltaT", c->delta_t, LUB_POSITIVE);
-        lub_dict_find(root, "elasticWall"); /* read by lub_mps_elastic_init */
-        lub_node *mr = lub_dict_map_or(root, "multiResolution");
-        if (mr) {
-            r->has_opt_state = 1;
-            r->next_id = (unsigned long long)lub_dict_int(mr, "nextId", 0, 1L << 62);
-            r->state_mass0 = lub_dict_real(mr, "mass0", LUB_NONNEGATIVE);
-        }
+        lub_models_declare_state(root); /* the models read their own entries */
         if (c->adjust_time_step) r->dt = dt < c->delta_t ? dt : c->delta_t;
         lub_dict_finish(st);
         lub_dict_free(st);
     }
     r->start_time = r->t;
-}
-
-void lubfoam_read_elastic(lubfoam_run *r, const lub_geometry *geo)
-{
-    char models[LUB_PATH_MAX], state[LUB_PATH_MAX], what[128];
-    lub_case_path(&r->cs, models, "constant/models.yaml");
-    lub_case_pathf(&r->cs, state, "%s/uniform/state.yaml", r->start_name);
-    int endtime = r->ctl.stop_at == LUB_STOP_ENDTIME;
-    snprintf(what, sizeof what, "endTime %g of system/controlDict.yaml", r->ctl.end_time);
-    const double end = endtime ? r->ctl.end_time : 0.0;
-    if (r->opt) {
-        /* every level's part of the wall (mps/elastic_wall.h, Multi-resolution) */
-        lub_mps *m[LUB_MAX_LEVELS];
-        for (int k = 0; k < r->opt->nlevels; k++) m[k] = &r->opt->m[k];
-        r->has_elastic = lub_mps_elastic_init_levels(&r->elastic, m, r->opt->nlevels, &r->opt->L,
-                                                     geo, models, state, end, what);
-    } else {
-        r->has_elastic = lub_mps_elastic_init(&r->elastic, &r->mps, geo, models, state, end, what);
-    }
 }
 
 static void write_state(const lubfoam_run *r, const char *dir)
@@ -100,13 +76,7 @@ static void write_state(const lubfoam_run *r, const char *dir)
     fprintf(fp, "time:   %.17g\n", r->t);
     fprintf(fp, "step:   %ld\n", r->step);
     fprintf(fp, "deltaT: %.17g\n", r->dt);
-    if (r->has_elastic) lub_mps_elastic_write_state(&r->elastic, fp);
-    if (r->opt)
-        fprintf(fp,
-                "multiResolution:\n"
-                "  nextId: %llu   # id of the next particle generated\n"
-                "  mass0:  %.17g   # fluid mass M^0 at the first start (T-27)\n",
-                (unsigned long long)r->opt->next_id, r->mass0);
+    lub_scene_write_state(&r->scene, fp);
     if (fclose(fp) != 0) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
 }
 

@@ -16,7 +16,7 @@
 #include "io/dict.h"
 #include "io/table.h"
 #include "models/elastic.h"
-#include "mps/levels.h"
+#include "models/multiResolution/levels.h"
 #include "reynolds/refcase.h"
 
 typedef enum {

@@ -11,7 +11,7 @@
 #include <sys/stat.h>
 
 #include "core/error.h"
-#include "io/particles_io.h"
+#include "particles/particles_io.h"
 #include "models/transport.h"
 #include "models/models.h"
 #include "post/film.h"
@@ -87,9 +87,9 @@ static const lub_elastic_wall *ctx_elastic(probe_ctx *x)
     return x->ew_state > 0 ? &x->ew : NULL;
 }
 
-/* The resolution levels of a multi-resolution case (mps/levels.h), read as the solver reads
- * them (constant/models.yaml multiResolution against system/particleGenDict.yaml, checked
- * against the particles P: fatal with file:line when they disagree), or NULL when
+/* The resolution levels of a multi-resolution case (models/multiResolution/levels.h), read as the
+ * solver reads them (constant/models.yaml multiResolution against system/particleGenDict.yaml,
+ * checked against the particles P: fatal with file:line when they disagree), or NULL when
  * models.yaml has no multiResolution entry. */
 static const lub_levels *ctx_levels(probe_ctx *x, const lub_particles *P)
 {
@@ -910,34 +910,24 @@ static void series_emit(job *j, double *sum, int nc)
 /* ---- totals: one row per time --------------------------------------------------------- */
 
 /* Multi-resolution totals (T-27): each fluid particle with the particle mass of its level
- * times the owned part of its cell (lub_levels_owned_fraction), as lubFoam's totals
- * function object counts them; owned[k]: the particles whose x their level owns. */
+ * times the owned part of its cell (lub_levels_sum), as lubFoam's totals function object
+ * counts them; owned[k]: the particles whose x their level owns. */
 static void owned_totals(const lub_particles *P, const lub_levels *L, double rho, lub_totals *t,
                          size_t owned[LUB_MAX_LEVELS])
 {
-    double su[LUB_MAX_LEVELS][3] = {{0}}, su2[LUB_MAX_LEVELS] = {0}, sf[LUB_MAX_LEVELS] = {0};
+    lub_levels_sums s;
+    memset(&s, 0, sizeof s);
     memset(t, 0, sizeof *t);
-    for (int k = 0; k < LUB_MAX_LEVELS; k++) owned[k] = 0;
-    for (size_t i = 0; i < P->n; i++) {
-        if (P->kind[i] != LUB_FLUID) continue;
-        const int k = P->level[i];
-        lub_level_where w;
-        lub_levels_locate(L, P->x[0][i], &w);
-        if (w.owner == k) owned[k]++;
-        const double f = lub_levels_owned_fraction(L, k, P->x[0][i]);
-        sf[k] += f;
-        for (int d = 0; d < P->dim; d++) {
-            su[k][d] += f * P->u[d][i];
-            su2[k] += f * P->u[d][i] * P->u[d][i];
-        }
-    }
+    lub_levels_sum(L, P, &s);
+    double m[LUB_MAX_LEVELS];
+    for (int k = 0; k < LUB_MAX_LEVELS; k++) owned[k] = s.owned[k];
     for (int k = 0; k < L->nlevels; k++) {
-        const double m = rho * pow(L->level[k].l0, P->dim);
+        m[k] = rho * pow(L->level[k].l0, P->dim);
         t->nfluid += owned[k];
-        t->mass += m * sf[k];
-        for (int d = 0; d < 3; d++) t->momentum[d] += m * su[k][d];
-        t->kinetic += 0.5 * m * su2[k];
+        for (int d = 0; d < 3; d++) t->momentum[d] += m[k] * s.fu[k][d];
+        t->kinetic += 0.5 * m[k] * s.fu2[k];
     }
+    t->mass = lub_levels_mass(&s, L->nlevels, m);
 }
 
 static void run_totals(job *j)

@@ -7,7 +7,7 @@
  * that simple every helper closes what it opened before returning, and files are opened with
  * H5F_CLOSE_STRONG so that closing the file also closes anything a path forgot.
  */
-#include "io/particles_io.h"
+#include "particles/particles_io.h"
 
 #include <errno.h>
 #include <fcntl.h>

@@ -94,9 +94,9 @@
  * beneath it.
  *
  * Multi-resolution (thesis 4-3, T-60..T-67; lub_mps_elastic_init_levels with the levels'
- * solvers of mps/opt.h).  Every level has its own wall and dummy particles of the patch in
- * its extended region, the overlaps included, and keeps its own slots, dummy interpolation
- * (between its own wall slots) and running means.  What couples them:
+ * solvers of models/multiResolution/opt.h).  Every level has its own wall and dummy particles of
+ * the patch in its extended region, the overlaps included, and keeps its own slots, dummy
+ * interpolation (between its own wall slots) and running means.  What couples them:
  *   - the pressure segments, the sources of T-46, count each point of x once: they are the
  *     wall particles of the level that owns their x (lub_levels_locate's owner: the fine
  *     level inside [a1, a2], the coarse one outside), sorted by x, with the half-way widths
@@ -133,8 +133,8 @@
  * reordered (or, multi-resolution, compacted) the particles.  No allocation after
  * lub_mps_elastic_init.
  */
-#ifndef LUB_MPS_ELASTIC_WALL_H
-#define LUB_MPS_ELASTIC_WALL_H
+#ifndef LUB_MODELS_ELASTICWALL_H
+#define LUB_MODELS_ELASTICWALL_H
 
 #include <stdint.h>
 #include <stdio.h>
@@ -142,7 +142,7 @@
 #include "geometry/geometry.h"
 #include "io/dict.h"
 #include "models/elastic.h"
-#include "mps/levels.h"
+#include "models/multiResolution/levels.h"
 #include "mps/mps.h"
 
 /* The patch's particles on one resolution level (single resolution: the only one). */
@@ -217,10 +217,10 @@ int lub_mps_elastic_init(lub_mps_elastic *w, lub_mps *m, const lub_geometry *g,
                          const char *models_path, const char *state_path, double end_time,
                          const char *end_what);
 
-/* The same for a multi-resolution run: the solvers m[0 .. nlevels) of the levels L (mps/opt.h
- * o->m, o->L), every level with its own wall and dummy particles of the patch (see
- * Multi-resolution above).  With nlevels 1 and L NULL it is lub_mps_elastic_init.  Fatal, as
- * that, also when a level has dummy particles of the patch but no wall particles. */
+/* The same for a multi-resolution run: the solvers m[0 .. nlevels) of the levels L
+ * (models/multiResolution/opt.h o->m, o->L), every level with its own wall and dummy particles of
+ * the patch (see Multi-resolution above).  With nlevels 1 and L NULL it is lub_mps_elastic_init.
+ * Fatal, as that, also when a level has dummy particles of the patch but no wall particles. */
 int lub_mps_elastic_init_levels(lub_mps_elastic *w, lub_mps *const *m, int nlevels,
                                 const lub_levels *L, const lub_geometry *g, const char *models_path,
                                 const char *state_path, double end_time, const char *end_what);

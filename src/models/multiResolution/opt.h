@@ -3,14 +3,14 @@
  *
  * Each resolution level is its own MPS system (mps.h: one lub_mps per level, with its own
  * l0, re = effectiveRadius l0, n0, lambda0, neighbour lists, viscosity and pressure solves);
- * the levels never interact pairwise.  They are coupled in the overlaps (mps/levels.h for the
- * regions): in the fixed band at the far edge of each level's overlap (T-25, T-26) the level's
- * particles are not computed, their velocity and pressure are given, interpolated by weighted
- * least squares (mps/lsq.h) from the other level's particles, and each level's free particles
- * see them as boundary values.  Any number of levels from 2 up (LUB_MAX_LEVELS): level k is
- * coupled with its neighbours k - 1 and k + 1 only, at the boundaries between them, so a
- * middle level has fixed bands at both ends of each piece of its ring (given by the finer
- * level at its hole, by the coarser level at its outer edges):
+ * the levels never interact pairwise.  They are coupled in the overlaps
+ * (models/multiResolution/levels.h for the regions): in the fixed band at the far edge of each
+ * level's overlap (T-25, T-26) the level's particles are not computed, their velocity and pressure
+ * are given, interpolated by weighted least squares (mps/lsq.h) from the other level's particles,
+ * and each level's free particles see them as boundary values.  Any number of levels from 2 up
+ * (LUB_MAX_LEVELS): level k is coupled with its neighbours k - 1 and k + 1 only, at the boundaries
+ * between them, so a middle level has fixed bands at both ends of each piece of its ring (given by
+ * the finer level at its hole, by the coarser level at its outer edges):
  *
  *     viscosity (T-31):  the band's velocities are Dirichlet values of the implicit solve
  *                        (§2-2-2 (3): velocities fixed outside L_outer);
@@ -22,8 +22,8 @@
  * complete: the level's particles end at the outer edge of the band, and the truncated
  * neighbourhoods there (PND deficit, one-sided) fall on Dirichlet particles only.  The
  * sources of an interpolation are the other level's fluid and wall particles that are not in
- * a band themselves (the two bands of an overlap never meet: mps/levels.c checks it), so
- * every level is interpolated from the same state, that of the start of the step.  Dummy
+ * a band themselves (the two bands of an overlap never meet: models/multiResolution/levels.c checks
+ * it), so every level is interpolated from the same state, that of the start of the step.  Dummy
  * particles are not sources: they carry the wall velocity behind the wall, not the no-slip
  * profile continued through it (step.c, dummy_velocity).  Particles move between the levels
  * by deletion past a level's extended region and generation in one-cell layers at its edges
@@ -59,9 +59,9 @@
  * only carry their patch velocity: every wall must be at rest or a plane sliding along itself
  * (movingWalls), which is translation invariant.  Other moving walls are refused at set-up.
  * The exception is a wall that a model moves while keeping its particles' x (mps.h
- * patch_moved): the elastic wall (mps/elastic_wall.h, Multi-resolution), whose particles on
- * every level move vertically with the one displacement computed from the wall pressure of
- * the levels owning each x (T-62..T-67), before each step of every level (commonDeltaT:
+ * patch_moved): the elastic wall (models/elasticWall/elasticWall.h, Multi-resolution), whose
+ * particles on every level move vertically with the one displacement computed from the wall
+ * pressure of the levels owning each x (T-62..T-67), before each step of every level (commonDeltaT:
  * the configuration refuses sub-stepping with it).  Its band particles (T-25, T-26) take
  * the other level's pressure like any wall particle's; lub_opt_moving_wall takes the
  * generation cells again without it and skips the cells behind it, since the wall leaves the
@@ -122,14 +122,14 @@
  * f the part of the particle's cell that lies where its level owns x
  * (lub_levels_owned_fraction): each point of space counted on one level.
  */
-#ifndef LUB_MPS_OPT_H
-#define LUB_MPS_OPT_H
+#ifndef LUB_MODELS_OPT_H
+#define LUB_MODELS_OPT_H
 
 #include <stddef.h>
 #include <stdint.h>
 
 #include "geometry/geometry.h"
-#include "mps/levels.h"
+#include "models/multiResolution/levels.h"
 #include "mps/lsq.h"
 #include "mps/mps.h"
 
@@ -207,8 +207,8 @@ typedef struct {
 } lub_opt;
 
 /* Set up from the particles P of all levels (not modified; its arrays are copied), the levels
- * L (mps/levels.h, checked against P), the solver configuration c (the same for every level;
- * lub_mps_init per level) and the geometry g (domain, walls; used for the margins, the
+ * L (models/multiResolution/levels.h, checked against P), the solver configuration c (the same for
+ * every level; lub_mps_init per level) and the geometry g (domain, walls; used for the margins, the
  * generation cells and the walls' check, not kept).  headroom: extra capacity per level, as a
  * fraction of its count (for particles generated later).  Fatal (exit 1) for a moving wall
  * that is not a plane sliding along itself, a patch moved by a model, or an extended region

@@ -1,5 +1,5 @@
 /* lubkit MPS: resolution levels of the overlapping particle technique (see levels.h). */
-#include "mps/levels.h"
+#include "models/multiResolution/levels.h"
 
 #include <math.h>
 #include <stdio.h>
@@ -445,6 +445,31 @@ double lub_levels_owned_fraction(const lub_levels *L, int k, double x)
         k == 0 ? 0 : covered(L, a, b, L->level[k - 1].region[0], L->level[k - 1].region[1]);
     const double f = (in_k - in_finer) / l0;
     return f < 0 ? 0 : f > 1 ? 1 : f;
+}
+
+void lub_levels_sum(const lub_levels *L, const lub_particles *P, lub_levels_sums *s)
+{
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->kind[i] != LUB_FLUID) continue;
+        const int k = P->level[i];
+        lub_level_where w;
+        lub_levels_locate(L, P->x[0][i], &w);
+        s->fluid[k]++;
+        if (w.owner == k) s->owned[k]++;
+        const double f = lub_levels_owned_fraction(L, k, P->x[0][i]);
+        s->f[k] += f;
+        for (int d = 0; d < P->dim; d++) {
+            s->fu[k][d] += f * P->u[d][i];
+            s->fu2[k] += f * P->u[d][i] * P->u[d][i];
+        }
+    }
+}
+
+double lub_levels_mass(const lub_levels_sums *s, int nlevels, const double *m)
+{
+    double mass = 0.0;
+    for (int k = 0; k < nlevels; k++) mass += m[k] * s->f[k]; /* T-27 */
+    return mass;
 }
 
 void lub_levels_describe(const lub_levels *L, char *buf, size_t size)

@@ -73,14 +73,14 @@
  * Mass correction (T-27..T-29; T-61 without cMin): when |M^k - M^0| > threshold M^0, the
  * particles of the overlaps get the x-velocity correction B sgn(M^k - M^0) (sign chosen by the
  * solver to drive the mass back, per boundary), B = max(min(|M^k - M^0| / (rho A C_relax dt),
- * cMax), cMin); mps/opt.h.
+ * cMax), cMin); models/multiResolution/opt.h.
  *
  * Errors are fatal with file:line of the entry (models.yaml, or particleGenDict.yaml for the
  * regions it owns); the reader asks for every key it knows, so lub_dict_finish() on
  * models.yaml reports unknown keys in multiResolution.
  */
-#ifndef LUB_MPS_LEVELS_H
-#define LUB_MPS_LEVELS_H
+#ifndef LUB_MODELS_LEVELS_H
+#define LUB_MODELS_LEVELS_H
 
 #include "geometry/geometry.h"
 #include "io/dict.h"
@@ -109,7 +109,7 @@ typedef struct {
     double lo, hi;    /* the overlap [lo, hi], hi - lo = L */
 } lub_level_boundary;
 
-typedef struct {
+typedef struct lub_levels {
     int dim;
     int nlevels;
     lub_level_def level[LUB_MAX_LEVELS];
@@ -168,6 +168,21 @@ void lub_levels_locate(const lub_levels *L, double x, lub_level_where *w);
  * a boundary moves M continuously, and a fine and a coarse particle straddling it share the
  * space between them. */
 double lub_levels_owned_fraction(const lub_levels *L, int k, double x);
+
+/* The sums of T-27 over the fluid particles of a particle set whose particles carry their
+ * level (P->level), each weighted by the owned part f of its cell (lub_levels_owned_fraction):
+ * per level the fluid particles, those whose x the level owns, and the sums of f, f u and
+ * f |u|^2.  Added to s (zero it first); serial, in the particles' order, so that the sums do
+ * not depend on the number of threads (the mass correction acts on them).  The one place
+ * where T-27 is summed: the mass correction (multiResolution/opt.c), lubFoam's totals and
+ * probe totals. */
+typedef struct {
+    size_t fluid[LUB_MAX_LEVELS], owned[LUB_MAX_LEVELS];
+    double f[LUB_MAX_LEVELS], fu[LUB_MAX_LEVELS][3], fu2[LUB_MAX_LEVELS];
+} lub_levels_sums;
+void lub_levels_sum(const lub_levels *L, const lub_particles *P, lub_levels_sums *s);
+/* The mass of T-27, M = sum_k m_k f_k (m: the particle mass rho l0_k^d of each level). */
+double lub_levels_mass(const lub_levels_sums *s, int nlevels, const double *m);
 
 /* Overlap length of the boundary between levels k and k + 1 [m]. */
 double lub_levels_overlap(const lub_levels *L, int k);

@@ -1,10 +1,12 @@
-/* lubkit MPS: the weight function.
+/* lubkit MPS: the weight function, and the reference values of a lattice of particles.
  *
  * Every MPS sum (PND, Laplacian, gradients, reference values n0 and lambda0) weighs a pair
- * through this one function, so that n0 and lambda0 stay consistent with the operators.
+ * through this one function, so that n0 and lambda0 stay consistent with the operators.  It
+ * lives with the particles, below the solver, so that a particle set (particleGen's levels)
+ * has its reference values without the solver (src/LAYERS).
  */
-#ifndef LUB_MPS_WEIGHT_H
-#define LUB_MPS_WEIGHT_H
+#ifndef LUB_PARTICLES_WEIGHT_H
+#define LUB_PARTICLES_WEIGHT_H
 
 /* thesis (T-6), Kondo & Koshizuka 2008: w(r) = (r/re - 1)^2 for r < re, 0 otherwise.
  * Finite at r = 0 (w = 1) and with w' = 0 at r = re, so PND varies smoothly as particles
@@ -23,5 +25,12 @@ static inline double lub_mps_weight_pair(double r, double inv_re, double re)
     const double q = r * inv_re - 1.0;
     return (double)(r < re) * (q * q);
 }
+
+/* Reference PND n0 and lambda0 (T-4, T-5) of a full square (2-D) or cubic (3-D) lattice of
+ * spacing l0, around one of its particles:
+ *     n0 = sum_j w(|r_j|, re),   lambda0 = sum_j |r_j|^2 w(|r_j|, re) / n0.
+ * With the particles (not the solver): the particle files carry them per level
+ * (geometry/discretise.h, lub_level_reference). */
+void lub_mps_reference(int dim, double l0, double re, double *n0, double *lambda0);
 
 #endif

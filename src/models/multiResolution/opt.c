@@ -1,5 +1,5 @@
 /* lubkit MPS: the overlapping particle technique, multi-resolution driver (see opt.h). */
-#include "mps/opt.h"
+#include "models/multiResolution/opt.h"
 
 #include <math.h>
 #include <omp.h>
@@ -10,7 +10,7 @@
 #include "core/error.h"
 #include "geometry/discretise.h"
 #include "mps/operators.h"
-#include "mps/weight.h"
+#include "particles/weight.h"
 
 /* ---- particles: split, fill, merge ------------------------------------------------------ */
 
@@ -1149,24 +1149,17 @@ lub_step_status lub_opt_step(lub_opt *o, double dt, int *level, long *bad, char 
 void lub_opt_mass_count(const lub_opt *o, lub_opt_mass *out)
 {
     memset(out, 0, sizeof *out);
+    /* each level's particles carry its level (the sums: serial, a few ns per particle) */
+    lub_levels_sums s;
+    memset(&s, 0, sizeof s);
+    double m[LUB_MAX_LEVELS];
     for (int k = 0; k < o->nlevels; k++) {
-        const lub_particles *P = &o->P[k];
-        size_t nf = 0, no = 0;
-        double frac = 0;
-        /* serial: the sum of the fractions in one order, whatever the number of threads
-         * (the mass correction acts on it; a few ns per particle) */
-        for (size_t i = 0; i < P->n; i++) {
-            if (P->kind[i] != LUB_FLUID) continue;
-            nf++;
-            lub_level_where w;
-            lub_levels_locate(&o->L, P->x[0][i], &w);
-            no += w.owner == k;
-            frac += lub_levels_owned_fraction(&o->L, k, P->x[0][i]);
-        }
-        out->fluid[k] = nf;
-        out->owned[k] = no;
-        out->mass += o->m[k].c.rho * pow(o->m[k].l0, o->dim) * frac;
+        lub_levels_sum(&o->L, &o->P[k], &s);
+        out->fluid[k] = s.fluid[k];
+        out->owned[k] = s.owned[k];
+        m[k] = o->m[k].c.rho * pow(o->m[k].l0, o->dim);
     }
+    out->mass = lub_levels_mass(&s, o->nlevels, m);
 }
 
 void lub_opt_rebuild_lists(lub_opt *o)

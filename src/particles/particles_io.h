@@ -20,8 +20,8 @@
  * relative to the folder); <case>/particles.xdmf is the temporal collection over all time
  * folders.  Both are XDMF 3 and open in ParaView's Xdmf3 readers without plugins.
  */
-#ifndef LUB_IO_PARTICLES_IO_H
-#define LUB_IO_PARTICLES_IO_H
+#ifndef LUB_PARTICLES_PARTICLES_IO_H
+#define LUB_PARTICLES_PARTICLES_IO_H
 
 #include <stddef.h>
 

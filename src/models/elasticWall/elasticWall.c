@@ -1,5 +1,5 @@
-/* lubkit MPS: the elasticWall model in the particle solver (see elastic_wall.h). */
-#include "mps/elastic_wall.h"
+/* lubkit model elasticWall: the elastic cylinder in the particle solver (see elasticWall.h). */
+#include "models/elasticWall/elasticWall.h"
 
 #include <math.h>
 #include <stdarg.h>
@@ -117,11 +117,7 @@ static int read_state(lub_mps_elastic *w, const char *path)
     lub_dict *d = w->state_dict = path ? lub_dict_read_optional(path) : NULL;
     if (!d) return 0;
     lub_node *root = lub_dict_root(d);
-    /* the solver's own entries (lubFoam reads them) */
-    lub_dict_find(root, "time");
-    lub_dict_find(root, "step");
-    lub_dict_find(root, "deltaT");
-    lub_dict_find(root, "multiResolution");
+    lub_models_declare_state(root); /* the solver's and the other models' entries */
     lub_node *s = lub_dict_map_or(root, "elasticWall");
     if (s) {
         w->h0 = lub_dict_real(s, "h0", LUB_ANY);
