@@ -366,10 +366,11 @@ static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, 
     if (!fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
     char names[512];
     size_t len = (size_t)snprintf(names, sizeof names,
-                                  "wallTime steps particles particleSteps usPerParticleStep "
-                                  "threads meanPressureIterations meanViscosityIterations");
-    for (int k = 0; k < LUB_T_COUNT; k++)
-        len += (size_t)snprintf(names + len, sizeof names - len, " %s", lub_mps_phase_names[k]);
+                                  "wallTime[s] steps particles particleSteps "
+                                  "usPerParticleStep[us] threads meanPressureIterations "
+                                  "meanViscosityIterations");
+    for (int k = 0; k < LUB_T_COUNT; k++) /* seconds per phase */
+        len += (size_t)snprintf(names + len, sizeof names - len, " %s[s]", lub_mps_phase_names[k]);
     lub_table_write_header(fp, names);
     enum { NFIXED = 8 };
     double row[NFIXED + LUB_T_COUNT] = {wall,

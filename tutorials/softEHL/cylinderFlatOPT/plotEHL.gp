@@ -5,7 +5,7 @@
 #
 # Files (Allrun writes them; the MPS ones are left out when absent or without rows):
 #   postProcessing/reynoldsRef/0/p.dat          # x p h X P H
-#   postProcessing/wallPressure/0/p.dat         # x p n  (lubFoam function object, time mean)
+#   postProcessing/wallPressure/0/p.dat         # x[m] p[Pa] n  (lubFoam function object, time mean)
 #   postProcessing/probe/wallShape.dat          # x y v h X H    (probe wallShape)
 #   postProcessing/probe/film.dat               # x h surface bottom contact n X H (probe film)
 #   postProcessing/elasticWall/0/elasticWall.dat  # t h0 centre load loadTarget ... (lubFoam)
