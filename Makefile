@@ -4,7 +4,7 @@
 #   make test       unit tests of src/ and case tests of the programs; ends "N passed, N failed"
 #   make demo       install missing packages, build, run the wedge tutorial, print its error
 #   make bench      benchmarks (microseconds per particle-step, time to accuracy)
-#   make install PREFIX=/usr/local
+#   make install PREFIX=/usr/local    programs, library, headers, lubkit.pc, etc/, tutorials
 #   make clean
 #
 # Sources are found by globbing: a file src/<concern>/<name>.c joins the library, a folder
@@ -128,12 +128,42 @@ bench: deps
 	@$(MAKE) --no-print-directory all $(BENCH_BINS)
 	@LUB_BUILD=$(BUILD) tests/bench/run
 
-install: all
-	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib $(DESTDIR)$(PREFIX)/share/lubkit
+# make install: a tree that works by itself (tests/cases/install runs a tutorial from one):
+#   PREFIX/bin/                  the programs and the scripts of bin/
+#   PREFIX/lib/liblub.a, PREFIX/lib/pkgconfig/lubkit.pc
+#   PREFIX/include/lubkit/<concern>/*.h      (#include "io/dict.h", as in src/)
+#   PREFIX/share/lubkit/         etc/ (bashrc, RunFunctions, templates), tutorials/, doc/,
+#                                README.md: etc/bashrc there puts PREFIX/bin on PATH, and
+#                                the tutorials' Allrun find it next to the programs on PATH
+# The tutorials and doc/ are the files git tracks (no results of runs in the source tree),
+# or the whole folders outside a git checkout.  DESTDIR stages the tree for a package.
+SHARE := $(DESTDIR)$(PREFIX)/share/lubkit
+.PHONY: $(BUILD)/lubkit.pc
+$(BUILD)/lubkit.pc:
+	@mkdir -p $(dir $@)
+	@{ echo 'prefix=$(PREFIX)'; echo 'libdir=$${prefix}/lib'; \
+	   echo 'includedir=$${prefix}/include'; echo; echo 'Name: lubkit'; \
+	   echo 'Description: MPS thin-film lubrication toolkit: the core library liblub'; \
+	   echo 'Version: $(VERSION)'; echo 'Requires: $(PKGS)'; \
+	   echo 'Cflags: -I$${includedir}/lubkit $(if $(CHOLMOD_INC),-I$(CHOLMOD_INC)) -fopenmp'; \
+	   echo 'Libs: -L$${libdir} -llub $(CHOLMOD_LIBS) -lm -fopenmp $(LDSAN)'; } >$@
+
+install: all $(BUILD)/lubkit.pc
+	install -d $(DESTDIR)$(PREFIX)/bin $(DESTDIR)$(PREFIX)/lib/pkgconfig $(SHARE)
 	install -m 755 $(BINS) $(DESTDIR)$(PREFIX)/bin/
 	for f in bin/*; do install -m 755 $$f $(DESTDIR)$(PREFIX)/bin/; done
 	install -m 644 $(LIB) $(DESTDIR)$(PREFIX)/lib/
-	cp -r etc $(DESTDIR)$(PREFIX)/share/lubkit/
+	install -m 644 $(BUILD)/lubkit.pc $(DESTDIR)$(PREFIX)/lib/pkgconfig/
+	cd src && for h in $$(find . -name '*.h'); do \
+	    install -D -m 644 $$h $(DESTDIR)$(PREFIX)/include/lubkit/$$h || exit 1; done
+	rm -rf $(SHARE)/etc $(SHARE)/tutorials $(SHARE)/doc
+	cp -r etc $(SHARE)/
+	install -m 644 README.md VERSION $(SHARE)/
+	if git ls-files --error-unmatch tutorials/README.md >/dev/null 2>&1; then \
+	    git ls-files tutorials doc | while IFS= read -r f; do \
+	        if [ -x "$$f" ]; then m=755; else m=644; fi; \
+	        install -D -m $$m "$$f" "$(SHARE)/$$f" || exit 1; done; \
+	else cp -r tutorials doc $(SHARE)/; fi
 
 format:
 	clang-format -i $$(find src applications tests -name '*.[ch]')

@@ -111,7 +111,7 @@ static int parse_item(const char *item, double *lo, double *hi)
     return 0;
 }
 
-size_t lub_case_select_times(const lub_case *c, const char *list, int latest, int no_zero,
+size_t lub_case_filter_times(const lub_case *c, const char *list, int latest, int no_zero,
                              lub_time **times)
 {
     lub_time *all;
@@ -143,19 +143,30 @@ size_t lub_case_select_times(const lub_case *c, const char *list, int latest, in
         sel[0] = sel[m - 1];
         m = 1;
     }
+    free(all);
+    *times = sel;
+    return m;
+}
+
+size_t lub_case_select_times(const lub_case *c, const char *list, int latest, int no_zero,
+                             lub_time **times)
+{
+    lub_time *sel;
+    size_t m = lub_case_filter_times(c, list, latest, no_zero, &sel);
     if (m == 0) {
+        free(sel);
+        lub_time *all;
+        size_t n = lub_case_times(c, &all);
         char avail[512] = "";
         size_t len = 0;
         for (size_t i = 0; i < n && len < sizeof avail - 16; i++)
             len += (size_t)snprintf(avail + len, sizeof avail - len, "%s%s", i ? " " : "",
                                     all[i].name);
         free(all);
-        free(sel);
         if (n == 0) lub_fatal("no time folders in case '%s'", c->root);
-        lub_fatal("no time folder of case '%s' matches the selection%s%s (available: %s)",
-                  c->root, list ? " -time " : "", list ? list : "", avail);
+        lub_fatal("no time folder of case '%s' matches the selection%s%s (available: %s)", c->root,
+                  list ? " -time " : "", list ? list : "", avail);
     }
-    free(all);
     *times = sel;
     return m;
 }

@@ -36,6 +36,11 @@ typedef struct {
  * value.  Returns the count; *times is allocated (free with free()). */
 size_t lub_case_times(const lub_case *c, lub_time **times);
 
+/* The time folders a selection keeps (see lub_case_select_times), possibly none; fatal
+ * (exit 1) only when the list is malformed.  *times is allocated (free with free()). */
+size_t lub_case_filter_times(const lub_case *c, const char *list, int latest, int no_zero,
+                             lub_time **times);
+
 /* Select times: list "0.01,0.02:0.03,0.05" (values and inclusive ranges, ":0.03" and
  * "0.02:" open), latest (only the last), no_zero (drop time 0).  Fatal (exit 1) when the
  * list is malformed or the selection is empty (the message lists what is available). */

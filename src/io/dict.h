@@ -50,6 +50,12 @@ lub_dict *lub_dict_read_optional(const char *path);
 lub_dict *lub_dict_parse(const char *name, const char *text);
 void lub_dict_free(lub_dict *d);
 
+/* Check an edit with the readers before it is written (lubDict): until called again with
+ * path NULL, every lub_dict_read / lub_dict_read_optional of the file at `path` (the same
+ * file under any name: device and inode) parses `text` instead, and its messages name the
+ * file `name`.  A path that does not exist substitutes nothing. */
+void lub_dict_substitute(const char *path, const char *name, const char *text);
+
 lub_node *lub_dict_root(const lub_dict *d);
 const char *lub_dict_path(const lub_dict *d);
 

@@ -295,6 +295,8 @@ typedef struct {
     const char *repl;
     const ynode *addmap; /* gets add appended after its entries */
     const char *add;
+    const ynode *dropin; /* loses its entry or item drop */
+    size_t drop;
 } canon_edit;
 
 static void canon(sbuf *b, const ynode *n, const canon_edit *ed)
@@ -315,12 +317,15 @@ static void canon(sbuf *b, const ynode *n, const canon_edit *ed)
         break;
     case YK_SEQ:
         sb_str(b, "[");
-        for (size_t i = 0; i < n->n; i++) canon(b, n->items[i], ed);
+        for (size_t i = 0; i < n->n; i++)
+            if (!ed || n != ed->dropin || i != ed->drop) canon(b, n->items[i], ed);
         sb_str(b, "]");
         break;
     default:
         sb_str(b, "{");
-        for (size_t i = 0; i < n->n; i++) canon(b, n->keys[i], ed), canon(b, n->items[i], ed);
+        for (size_t i = 0; i < n->n; i++)
+            if (!ed || n != ed->dropin || i != ed->drop)
+                canon(b, n->keys[i], ed), canon(b, n->items[i], ed);
         if (ed && n == ed->addmap) sb_str(b, ed->add);
         sb_str(b, "}");
         break;
@@ -735,9 +740,9 @@ static int splice_checked(lub_yaml_text *y, size_t start, size_t end, const char
     ytree t;
     if (!tree_parse(&t, text, len)) {
         snprintf(err, errsz,
-                 "%s '%s=%s' would make the file invalid YAML (line %d, column %d: %s); the "
+                 "%s '%s%s%s' would make the file invalid YAML (line %d, column %d: %s); the "
                  "file is left unchanged",
-                 what, key, value, t.eline, t.ecol, t.problem);
+                 what, key, value ? "=" : "", value ? value : "", t.eline, t.ecol, t.problem);
         tree_free(&t);
         free(text);
         return -1;
@@ -746,6 +751,14 @@ static int splice_checked(lub_yaml_text *y, size_t start, size_t end, const char
     int same = strcmp(got, expect) == 0;
     free(got);
     tree_free(&t);
+    if (!same && !value) {
+        snprintf(err, errsz,
+                 "%s '%s': the entry cannot be taken out of this layout without changing "
+                 "other entries; the file is left unchanged",
+                 what, key);
+        free(text);
+        return -1;
+    }
     if (!same) {
         snprintf(err, errsz,
                  "%s '%s=%s': the value does not fit in place (it would change other entries; "
@@ -888,4 +901,166 @@ void lub_yaml_add(lub_yaml_text *y, const char *key, const char *value)
     path_free(&p);
     tree_free(&t);
     if (rc) lub_fatal_at(y->name, 0, 0, "%s", err);
+}
+
+/* ---- removing ------------------------------------------------------------------------- */
+
+static size_t line_start(const lub_yaml_text *y, size_t pos)
+{
+    while (pos > 0 && y->text[pos - 1] != '\n') pos--;
+    return pos;
+}
+
+/* Just after the line break that ends the line holding pos (or the end of the text). */
+static size_t line_after(const lub_yaml_text *y, size_t pos)
+{
+    while (pos < y->len && y->text[pos] != '\n') pos++;
+    return pos < y->len ? pos + 1 : pos;
+}
+
+/* The text of [from, to) is blanks, with one '-' among them when dash (a block item). */
+static int blank_before(const lub_yaml_text *y, size_t from, size_t to, int dash)
+{
+    int dashes = 0;
+    for (size_t i = from; i < to; i++) {
+        if (y->text[i] == '-' && dash && !dashes++) continue;
+        if (y->text[i] != ' ' && y->text[i] != '\t') return 0;
+    }
+    return !dash || dashes == 1;
+}
+
+/* Column (0-based) of a comment after pos on its line, or -1. */
+static long trailing_comment(const lub_yaml_text *y, size_t pos)
+{
+    size_t ls = line_start(y, pos);
+    for (size_t i = pos; i < y->len && y->text[i] != '\n'; i++)
+        if (y->text[i] == '#' && (i == 0 || strchr(" \t", y->text[i - 1]))) return (long)(i - ls);
+    return -1;
+}
+
+void lub_yaml_remove(lub_yaml_text *y, const char *key)
+{
+    if (!key || !*key) lub_fatal_at(y->name, 0, 0, "-remove: empty key");
+    char err[2048];
+    ytree t;
+    ypath p;
+    ynode *n = find(y, &t, &p, key); /* fatal (freeing its own) when absent */
+    ypath pp = p;
+    pp.nseg--;
+    ynode *parent = lookup(t.root, &pp).node;
+    size_t i = 0;
+    while (i < parent->n && parent->items[i] != n) i++;
+    const int map = parent->kind == YK_MAP, last = i + 1 == parent->n;
+    size_t s_i = map ? parent->keys[i]->start : n->start, e_i = n->end;
+    size_t next = last ? 0 : map ? parent->keys[i + 1]->start : parent->items[i + 1]->start;
+    size_t a, b;
+    const char *ins = "";
+    if (parent->flow) {
+        /* "{a: 1, b: 2}": up to the next entry, or from the end of the one before */
+        a = parent->n == 1 ? s_i : last ? parent->items[i - 1]->end : s_i;
+        b = parent->n == 1 || last ? e_i : next;
+    } else if (blank_before(y, line_start(y, s_i), s_i, !map)) {
+        if (parent->n == 1 && parent != t.root) {
+            /* the last entry of a nested block collection: it becomes an empty flow one */
+            a = map ? s_i : line_start(y, s_i) + strspn(y->text + line_start(y, s_i), " \t");
+            b = e_i;
+            ins = map ? "{}" : "[]";
+        } else {
+            /* whole lines: the entry's, and the continuation lines of its comment (comment
+             * lines whose '#' is aligned with the one after the value) */
+            a = line_start(y, s_i);
+            b = line_after(y, e_i);
+            long col = trailing_comment(y, e_i);
+            while (col >= 0 && b < y->len) {
+                size_t e = line_after(y, b), k = b;
+                while (k < e && strchr(" \t", y->text[k])) k++;
+                if (k >= e || y->text[k] != '#' || (long)(k - b) != col) break;
+                b = e;
+            }
+        }
+    } else if (!last) {
+        /* "- a: 1\n  b: 2" without a: "- b: 2" */
+        a = s_i;
+        b = next;
+    } else {
+        a = s_i;
+        b = e_i;
+        ins = map ? "{}" : "[]";
+    }
+    canon_edit ed = {.dropin = parent, .drop = i};
+    /* the only entry of a block document: the document becomes empty (comments at most) */
+    char *expect = parent == t.root && parent->n == 1 && !parent->flow ? lub_strdup("")
+                                                                       : canon_of(t.root, &ed);
+    int rc = splice_checked(y, a, b, ins, expect, "-remove", key, NULL, err, sizeof err);
+    free(expect);
+    path_free(&p);
+    tree_free(&t);
+    if (rc) lub_fatal_at(y->name, 0, 0, "%s", err);
+}
+
+/* ---- every value ---------------------------------------------------------------------- */
+
+static void flat_value(sbuf *b, const char *v)
+{
+    for (; *v; v++) {
+        if (*v == '\n')
+            sb_str(b, "\\n");
+        else
+            sb_add(b, v, 1);
+    }
+}
+
+static void flat_node(const lub_yaml_text *y, sbuf *b, const ynode *n, sbuf *path)
+{
+    size_t mark = path->n;
+    int leaf = n->kind == YK_SCALAR || n->kind == YK_ALIAS || n->n == 0;
+    if (n->kind == YK_SEQ && !leaf) {
+        leaf = 1; /* a list of plain values, such as a vector: on one line */
+        for (size_t i = 0; i < n->n && leaf; i++) leaf = n->items[i]->kind == YK_SCALAR;
+    }
+    if (leaf) {
+        sb_add(b, path->s ? path->s : "", path->n);
+        sb_str(b, " = ");
+        if (n->kind == YK_SCALAR) {
+            flat_value(b, n->value);
+        } else if (n->kind == YK_ALIAS) {
+            sb_str(b, "*"), sb_str(b, n->value);
+        } else {
+            sb_str(b, n->kind == YK_SEQ ? "[" : "{");
+            for (size_t i = 0; i < n->n; i++) {
+                const ynode *it = n->items[i];
+                if (i) sb_str(b, ", ");
+                sb_add(b, y->text + it->start, it->end - it->start);
+            }
+            sb_str(b, n->kind == YK_SEQ ? "]" : "}");
+        }
+        sb_str(b, "\n");
+        return;
+    }
+    for (size_t i = 0; i < n->n; i++) {
+        if (path->n) sb_str(path, ".");
+        if (n->kind == YK_SEQ)
+            sb_fmt(path, "%zu", i);
+        else if (n->keys[i]->kind == YK_SCALAR)
+            sb_str(path, n->keys[i]->value);
+        else
+            sb_add(path, y->text + n->keys[i]->start, n->keys[i]->end - n->keys[i]->start);
+        flat_node(y, b, n->items[i], path);
+        path->n = mark;
+        if (path->s) path->s[mark] = '\0';
+    }
+}
+
+char *lub_yaml_values(const lub_yaml_text *y, const char *key)
+{
+    ytree t;
+    ypath p;
+    ynode *n = find(y, &t, &p, key && *key ? key : "");
+    sbuf b = {0}, path = {0};
+    if (key && *key) sb_str(&path, key);
+    if (n) flat_node(y, &b, n, &path);
+    free(path.s);
+    path_free(&p);
+    tree_free(&t);
+    return sb_take(&b);
 }

@@ -49,6 +49,18 @@ void lub_yaml_set(lub_yaml_text *y, const char *key, const char *value);
  * "b: {c: 1}" to a).  Fatal if the entry exists. */
 void lub_yaml_add(lub_yaml_text *y, const char *key, const char *value);
 
+/* Take the entry at key out of its mapping or sequence: in block style its whole lines go
+ * (with the comment after its value and that comment's continuation lines, aligned under
+ * it), the other lines and comments stay; the last entry of a nested block collection
+ * leaves an empty flow one ("{}", "[]").  Fatal if the entry does not exist. */
+void lub_yaml_remove(lub_yaml_text *y, const char *key);
+
+/* Every value under key ("" or NULL: the whole document) as "path = value" lines, path a
+ * dot path as lub_yaml_get takes it: scalars as their value (a line break as "\n"), a
+ * sequence of scalars on one line as "[a, b]" (each item's source text), an empty
+ * collection as "[]" or "{}", an alias as "*name".  Newly allocated. */
+char *lub_yaml_values(const lub_yaml_text *y, const char *key);
+
 /* "key=value" split at the first '=' into key and value buffers (allocated); fatal on a
  * missing '=' or an empty key.  what names the option in messages ("-set"). */
 void lub_yaml_split_assignment(const char *arg, const char *what, char **key, char **value);

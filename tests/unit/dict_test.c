@@ -177,6 +177,42 @@ static void test_files(void)
     CHECK_FATAL(lub_dict_read("/nonexistent/dir/x.yaml"), "cannot open dictionary '/nonexistent/dir/x.yaml'");
 }
 
+/* lub_dict_substitute: the same file under another name parses the given text, messages
+ * name the given name; other files are read as they are; NULL ends it. */
+static void test_substitute(void)
+{
+    char dir[] = "/tmp/lubdictsubXXXXXX";
+    CHECK(mkdtemp(dir) != NULL);
+    char a[128], a2[160], b[128];
+    snprintf(a, sizeof a, "%s/a.yaml", dir);
+    snprintf(a2, sizeof a2, "%s/./a.yaml", dir);
+    snprintf(b, sizeof b, "%s/b.yaml", dir);
+    FILE *fp = fopen(a, "w");
+    CHECK(fp && fputs("nu: 1\n", fp) >= 0 && fclose(fp) == 0);
+    fp = fopen(b, "w");
+    CHECK(fp && fputs("nu: 2\n", fp) >= 0 && fclose(fp) == 0);
+    lub_dict_substitute(a, "constant/a.yaml", "nu: 3\n");
+    lub_dict *d = lub_dict_read(a2);
+    CHECK_NEAR(lub_dict_real(lub_dict_root(d), "nu", LUB_POSITIVE), 3, 0);
+    CHECK(strcmp(lub_dict_path(d), "constant/a.yaml") == 0);
+    lub_dict_free(d);
+    d = lub_dict_read_optional(b);
+    CHECK_NEAR(lub_dict_real(lub_dict_root(d), "nu", LUB_POSITIVE), 2, 0);
+    lub_dict_free(d);
+    lub_dict_substitute(a, "constant/a.yaml", "nu: abc\n");
+    d = lub_dict_read(a);
+    CHECK_FATAL(lub_dict_real(lub_dict_root(d), "nu", LUB_POSITIVE),
+                "constant/a.yaml:1:5: 'nu' expects a real number");
+    lub_dict_free(d);
+    lub_dict_substitute(NULL, NULL, NULL);
+    d = lub_dict_read(a);
+    CHECK_NEAR(lub_dict_real(lub_dict_root(d), "nu", LUB_POSITIVE), 1, 0);
+    lub_dict_free(d);
+    unlink(a);
+    unlink(b);
+    rmdir(dir);
+}
+
 static void test_closest(void)
 {
     const char *c[] = {"gradient", "laplacian", "viscosity"};
@@ -197,6 +233,7 @@ int main(void)
     RUN(test_missing_key);
     RUN(test_malformed);
     RUN(test_files);
+    RUN(test_substitute);
     RUN(test_closest);
     return test_summary();
 }

@@ -306,6 +306,61 @@ static void test_add(void)
     lub_yaml_text_free(&y);
 }
 
+/* Every expected text by hand: the entry's lines go (with the comment after the value and
+ * its aligned continuation lines), the rest stays byte for byte. */
+static void test_remove(void)
+{
+    lub_yaml_text y;
+    lub_yaml_text_init(
+        &y, "r.yaml",
+        "a: 1   # c\n       # more of c\n# about sub\nsub:\n  x: 1\n  y: [1,\n      2]"
+        "  # c2\nf: { p: 1, q: 2, r: 3 }\nl:\n- k: 1\n  j: 2\n- 5\nz: 0\n");
+    lub_yaml_remove(&y, "a");
+    lub_yaml_remove(&y, "sub.y");
+    lub_yaml_remove(&y, "f.p");
+    lub_yaml_remove(&y, "f.r");
+    lub_yaml_remove(&y, "l.0.k");
+    lub_yaml_remove(&y, "l.1");
+    const char *want = "# about sub\nsub:\n  x: 1\nf: { q: 2 }\nl:\n- j: 2\nz: 0\n";
+    CHECK(strcmp(y.text, want) == 0);
+    if (strcmp(y.text, want) != 0) printf("%s", y.text);
+    lub_yaml_remove(&y, "sub.x"); /* the last entry of a nested block mapping */
+    lub_yaml_remove(&y, "f.q");   /* of a flow one */
+    want = "# about sub\nsub:\n  {}\nf: {  }\nl:\n- j: 2\nz: 0\n";
+    CHECK(strcmp(y.text, want) == 0);
+    if (strcmp(y.text, want) != 0) printf("%s", y.text);
+    CHECK_FATAL(lub_yaml_remove(&y, "zz"), "no entry 'zz' (did you mean 'z'?)");
+    CHECK_FATAL(lub_yaml_remove(&y, "l.3"), "'l' has 1 items");
+    CHECK(strcmp(y.text, want) == 0);
+    lub_yaml_text_free(&y);
+
+    lub_yaml_text_init(&y, "one.yaml", "# header\nonly: [1, 2]   # c\n");
+    lub_yaml_remove(&y, "only");
+    CHECK(strcmp(y.text, "# header\n") == 0);
+    lub_yaml_text_free(&y);
+}
+
+static void test_values(void)
+{
+    lub_yaml_text y;
+    lub_yaml_text_init(&y, "v.yaml",
+                       "a: 1   # c\ns: 'q x'\nsub: { x: [1, -2.5e-3], e: {}, n: [] }\n"
+                       "l:\n- k: v\n- [3, 4]\n- - 5\n  - 6\nt: |\n  one\n  two\nnul:\n");
+    char *v = lub_yaml_values(&y, NULL);
+    const char *want = "a = 1\ns = q x\nsub.x = [1, -2.5e-3]\nsub.e = {}\nsub.n = []\n"
+                       "l.0.k = v\nl.1 = [3, 4]\nl.2 = [5, 6]\nt = one\\ntwo\\n\nnul = \n";
+    CHECK(strcmp(v, want) == 0);
+    if (strcmp(v, want) != 0) printf("%s", v);
+    free(v);
+    v = lub_yaml_values(&y, "sub");
+    CHECK(strcmp(v, "sub.x = [1, -2.5e-3]\nsub.e = {}\nsub.n = []\n") == 0);
+    free(v);
+    v = lub_yaml_values(&y, "a");
+    CHECK(strcmp(v, "a = 1\n") == 0);
+    free(v);
+    lub_yaml_text_free(&y);
+}
+
 static void test_syntax_errors(void)
 {
     lub_yaml_text y;
@@ -380,6 +435,8 @@ int main(void)
     RUN(test_set_flow);
     RUN(test_set_rejected);
     RUN(test_add);
+    RUN(test_remove);
+    RUN(test_values);
     RUN(test_syntax_errors);
     RUN(test_write);
     RUN(test_split);

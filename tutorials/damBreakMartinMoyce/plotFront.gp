@@ -7,7 +7,16 @@ set key top left
 set grid
 set xrange [0:3.5]
 set yrange [1:4.2]
-set title "Collapse of a water column (n^2 = 2): surge front"
-plot "postProcessing/probe/frontZT.dat" using 1:2 with lines lw 2 title "lubFoam (MPS)", \
+# the case's column (fluid region 0): width a, height n^2 a, and its l0 (lubDict: lubkit on
+# PATH, as in the Allrun; nan where it cannot be read)
+# (awk writes each number with a decimal point: gnuplot's real() refuses "1e-5")
+num(key) = (_s = system(sprintf("lubDict system/particleGenDict.yaml %s 2>/dev/null | awk '{ printf \"%%.17e\", $1 }'", key)), _s eq "" ? NaN : real(_s))
+a = num("fluid.0.max.0") - num("fluid.0.min.0")
+n2 = (num("fluid.0.max.1") - num("fluid.0.min.1")) / a
+l0 = num("l0")
+caption = sprintf("Collapse of a water column (n^2 = %.3g): surge front", n2)
+set title caption
+mps_title = sprintf("lubFoam (MPS), a = %g m, l_0 = a/%.3g", a, a / l0)
+plot "postProcessing/probe/frontZT.dat" using 1:2 with lines lw 2 title mps_title, \
      "martinMoyce1952.dat" using ($3 == 1.125 ? $1 : 1/0):2 with points pt 7 title "Martin and Moyce, a = 1.125 in", \
      "martinMoyce1952.dat" using ($3 == 2.25 ? $1 : 1/0):2 with points pt 5 title "Martin and Moyce, a = 2.25 in"

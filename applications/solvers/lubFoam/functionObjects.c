@@ -375,7 +375,7 @@ void lubfoam_functions_write(lubfoam_functions *F, lubfoam_run *r)
         lub_atomic_file af;
         FILE *fp = lub_atomic_open(&af, path);
         if (!fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
-        lub_table_write_header(fp, "x p n");
+        lub_table_write_header(fp, "x[m] p[Pa] n");
         fprintf(fp, "# samples %ld steps from t = %.17g to t = %.17g\n", o->samples, o->tfirst,
                 o->tlast);
         for (int b = 0; b < o->nbins; b++) {

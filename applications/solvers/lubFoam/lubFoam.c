@@ -191,6 +191,16 @@ static lub_timers *run_timers(lubfoam_run *r)
     return &r->scene.level[0]->tm;
 }
 
+/* Everything main allocated for the run. */
+static void run_free(lubfoam_run *r, lubfoam_functions *fos)
+{
+    lubfoam_functions_free(fos);
+    lub_scene_free(&r->scene);
+    lub_particles_free(&r->P);
+    lub_control_free(&r->ctl);
+    free(r->written);
+}
+
 /* Cost summary on the log and in postProcessing/cost/<startTime>/cost.dat. */
 static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, double vit_sum)
 {
@@ -209,10 +219,11 @@ static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, 
     if (!fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
     char names[512];
     size_t len = (size_t)snprintf(names, sizeof names,
-                                  "wallTime steps particles particleSteps usPerParticleStep "
-                                  "threads meanPressureIterations meanViscosityIterations");
-    for (int k = 0; k < LUB_T_COUNT; k++)
-        len += (size_t)snprintf(names + len, sizeof names - len, " %s", lub_mps_phase_names[k]);
+                                  "wallTime[s] steps particles particleSteps "
+                                  "usPerParticleStep[us] threads meanPressureIterations "
+                                  "meanViscosityIterations");
+    for (int k = 0; k < LUB_T_COUNT; k++) /* seconds per phase */
+        len += (size_t)snprintf(names + len, sizeof names - len, " %s[s]", lub_mps_phase_names[k]);
     lub_table_write_header(fp, names);
     enum { NFIXED = 8 };
     double row[NFIXED + LUB_T_COUNT] = {wall,
@@ -246,7 +257,13 @@ int main(int argc, char **argv)
             "  current state and exit 0.  A non-finite value, a particle leaving the\n"
             "  domain or a fluid particle going through a wall stops the run with exit 2,\n"
             "  naming the particle (and the wall) and the step; the newest time folder is\n"
-            "  then the last good state.",
+            "  then the last good state.\n"
+            "  startFrom: startTime over the results of an earlier run overwrites each time\n"
+            "  folder and table the run writes again and leaves the others (the log warns,\n"
+            "  listing them): lubClean removes them first, startFrom: latestTime continues.\n"
+            "  -dryRun reads and checks every dictionary and the start particles, prints the\n"
+            "  start-up figures (particles, schemes, models, Courant and diffusion numbers,\n"
+            "  multi-resolution checks), runs nothing and writes nothing.",
         .dictionaries = "system/controlDict.yaml\nsystem/particleGenDict.yaml (domain)\n"
                         "system/schemes.yaml\nsystem/solution.yaml (optional)\n"
                         "constant/transportProperties.yaml\nconstant/models.yaml\n"
@@ -256,8 +273,14 @@ int main(int argc, char **argv)
         .min_args = 0,
         .max_args = 0,
     };
+    int dry_run = 0;
+    lub_option opts[] = {{"-dryRun", NULL,
+                          "check the case and print the start-up figures; run nothing, write "
+                          "nothing",
+                          LUB_OPT_FLAG, &dry_run},
+                         {0}};
     lub_args a;
-    lub_args_parse(&a, argc, argv, &info, NULL);
+    lub_args_parse(&a, argc, argv, &info, opts);
     /* the machine's load, read before this program starts its OpenMP threads: the runnable
      * tasks then count only this thread of it */
     int runnable;
@@ -299,7 +322,7 @@ int main(int argc, char **argv)
         lub_message("lubFoam: the start time %s is at or past endTime %g: nothing to run, "
                     "nothing written (raise endTime in system/controlDict.yaml to continue)",
                     r.start_name, r.ctl.end_time);
-    else
+    else if (!dry_run)
         lubfoam_functions_start(fos, &r);
 
     /* The last step is never shortened to land on endTime (as OpenFOAM with a fixed deltaT):
@@ -317,6 +340,13 @@ int main(int argc, char **argv)
                         "start time %s: the run ends at the first step after it, t = %.9g "
                         "(%.0f steps; a step is never shortened to land on endTime)",
                         r.ctl.end_time, h, r.start_name, t_last, k * nr);
+    }
+    if (dry_run) {
+        lub_message("lubFoam -dryRun: the dictionaries and the particles of time %s are valid; "
+                    "nothing run, nothing written",
+                    r.start_name);
+        run_free(&r, fos);
+        return LUB_EXIT_OK;
     }
 
     install_stop_handlers();
@@ -420,11 +450,7 @@ int main(int argc, char **argv)
                     r.t, r.t - r.ctl.end_time, r.ctl.end_time);
     if (!nothing_to_run) write_cost(&r, steps, lub_wtime() - wall0, pit_sum, vit_sum);
     if (!nothing_to_run) lub_scene_summary(&r.scene, r.t);
-    lubfoam_functions_free(fos);
-    lub_scene_free(&r.scene);
-    lub_particles_free(&r.P);
-    lub_control_free(&r.ctl);
-    free(r.written);
+    run_free(&r, fos);
     if (status == LUB_EXIT_OK) lub_message("End");
     return status;
 }

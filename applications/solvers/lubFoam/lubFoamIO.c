@@ -1,9 +1,12 @@
 /* lubFoam: start time, restart state and time folders. */
+#include <dirent.h>
 #include <errno.h>
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
 
+#include "core/args.h"
 #include "core/error.h"
 #include "io/dict.h"
 #include "particles/particles_io.h"
@@ -16,6 +19,54 @@ static int has_particles(const lub_case *c, const char *name)
     struct stat st;
     lub_case_pathf(c, p, "%s/particles.h5", name);
     return stat(p, &st) == 0;
+}
+
+/* startFrom: startTime in a case that holds results after the start time (an Allrun run
+ * again without Allclean, a case copied with its results): the run overwrites the time
+ * folders and postProcessing/<name>/<start>/ tables it writes again and leaves the others,
+ * so that the case mixes two runs.  Said in the log, with what is there. */
+static void warn_earlier_results(const lub_case *cs, const char *start)
+{
+    double t0 = 0;
+    lub_parse_real(start, &t0);
+    lub_time *t;
+    size_t n = lub_case_times(cs, &t), first = n;
+    for (size_t k = 0; k < n && first == n; k++)
+        if (t[k].value > t0 + 1e-9 * fmax(fabs(t0), 1e-300)) first = k;
+    char tables[512] = "", dir[LUB_PATH_MAX], sub[LUB_PATH_MAX];
+    size_t len = 0, ntables = 0;
+    DIR *d = opendir(lub_case_path(cs, dir, "postProcessing"));
+    struct dirent *e;
+    while (d && (e = readdir(d))) {
+        struct stat st;
+        if (e->d_name[0] == '.') continue;
+        if (snprintf(sub, sizeof sub, "%s/%s/%s", dir, e->d_name, start) >= (int)sizeof sub ||
+            stat(sub, &st) != 0 || !S_ISDIR(st.st_mode))
+            continue;
+        if (len < sizeof tables)
+            len += (size_t)snprintf(tables + len, sizeof tables - len, "%s%s", ntables ? "," : "",
+                                    e->d_name);
+        ntables++;
+    }
+    if (d) closedir(d);
+    if (first < n || ntables) {
+        char folders[256] = "";
+        if (first < n)
+            snprintf(folders, sizeof folders, "%zu later time folder%s (%s%s%s)", n - first,
+                     n - first > 1 ? "s" : "", t[first].name, n - first > 1 ? " to " : "",
+                     n - first > 1 ? t[n - 1].name : "");
+        char pp[768] = "";
+        if (ntables)
+            snprintf(pp, sizeof pp, "%sthe tables postProcessing/%s%s%s/%s/",
+                     first < n ? " and " : "", ntables > 1 ? "{" : "", tables,
+                     ntables > 1 ? "}" : "", start);
+        lub_warning("startFrom: startTime %s, and the case holds results of an earlier run: "
+                    "%s%s: this run overwrites those it writes again and leaves the others as "
+                    "they are, so that the case mixes two runs (startFrom: latestTime "
+                    "continues the earlier run; lubClean removes its results)",
+                    start, folders, pp);
+    }
+    free(t);
 }
 
 void lubfoam_read_start(lubfoam_run *r)
@@ -43,6 +94,7 @@ void lubfoam_read_start(lubfoam_run *r)
                       c->start_time, r->cs.root, name);
     }
     snprintf(r->start_name, sizeof r->start_name, "%s", name);
+    if (c->start_from == LUB_START_STARTTIME) warn_earlier_results(&r->cs, name);
     lub_particles_read(&r->P, lub_case_pathf(&r->cs, path, "%s/particles.h5", name));
     r->t = r->P.time;
     r->step = r->P.step;

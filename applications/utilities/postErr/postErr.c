@@ -37,7 +37,8 @@ static const char *description =
     "The signed errors (peakErr, xPeakErr, xPeakErrRel, integralErr) are nan when their\n"
     "reference is 0.  Output: one 'name value' line each for xmin xmax n relL1 relL2 relLinf\n"
     "peak peakRef peakErr xPeak xPeakRef xPeakErr xPeakErrRel integral integralRef\n"
-    "integralErr (n: points of the comparison grid).\n"
+    "integralErr (n: points of the comparison grid), then a comment line '# relative\n"
+    "error: L2 3.71%, ...' that says the same in per cent for a reader.\n"
     "\n"
     "-max NORM=VALUE fails (exit 1, after printing) when |NORM| > VALUE; NORM is one of\n"
     "relL1 relL2 relLinf peakErr xPeakErr xPeakErrRel integralErr.  Errors (exit 1): no\n"
@@ -61,6 +62,18 @@ static int point_cmp(const void *pa, const void *pb)
     const point *a = pa, *b = pb;
     if (a->x != b->x) return a->x < b->x ? -1 : 1;
     return a->row < b->row ? -1 : a->row > b->row; /* stable: keep the file's order */
+}
+
+/* A ratio in per cent for the summary line, "3.71%" ("+3.71%" signed; "undefined" for nan),
+ * in one of six buffers so that one printf can take several. */
+static const char *percent(double v, int sign, int slot)
+{
+    static char buf[6][32];
+    if (isnan(v))
+        snprintf(buf[slot], sizeof buf[slot], "undefined (zero reference)");
+    else
+        snprintf(buf[slot], sizeof buf[slot], sign ? "%+.3g%%" : "%.3g%%", 100 * v);
+    return buf[slot];
 }
 
 /* Columns xname, yname of t as a function sorted by x. */
@@ -317,6 +330,14 @@ int main(int argc, char **argv)
             xpeakref, norm[4], norm[5]);
     fprintf(o.fp, "integral %.17g\nintegralRef %.17g\nintegralErr %.17g\n", integral, integralref,
             norm[6]);
+    /* the same for a reader: a comment line, which the scripts that read 'name value' lines
+     * (lubSweep, the Allruns: awk '$1 == "relL2"') pass over */
+    fprintf(o.fp,
+            "# relative error: L2 %s, L1 %s, Linf %s; peak %.4g against %.4g (%s) at x = %.4g "
+            "against %.4g (%s of the range); integral %s\n",
+            percent(norm[1], 0, 0), percent(norm[0], 0, 1), percent(norm[2], 0, 2), peak, peakref,
+            percent(norm[3], 1, 3), xpeak, xpeakref, percent(norm[5], 1, 4),
+            percent(norm[6], 1, 5));
     lub_output_close(&o);
 
     /* accuracy assertions, after the results are out so that a log shows them */

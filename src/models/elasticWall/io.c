@@ -31,10 +31,23 @@ typedef struct {
  * levels cannot run yet, refused with the entries' lines.  It moves every level's wall each
  * step from one deformation: every level takes the same steps (T-60); it is tested on two
  * levels (tests/cases/softEHLOPT). */
+/* The entry read and checked when the scene is read (its fields again at the init, which
+ * needs the solvers), so that a bad entry stops a program that only reads the case's
+ * dictionaries (lubDict's check of an edit) as it stops lubFoam; after the checks of the
+ * combination with multiResolution, which come first. */
+static void check_entry(lub_scene *s)
+{
+    lub_elastic_wall e;
+    lub_elastic_wall_read(lub_dict_root(s->dict), s->geo, &e);
+}
+
 static void elastic_check(lub_model *m, lub_scene *s)
 {
     const lub_levels *L = s->levels;
-    if (!L || L->nlevels < 2) return;
+    if (!L || L->nlevels < 2) {
+        check_entry(s);
+        return;
+    }
     const char *file = L->file[0] ? L->file : "constant/models.yaml";
     if (L->nlevels > 2)
         lub_node_error(m->entry,
@@ -52,6 +65,7 @@ static void elastic_check(lub_model *m, lub_scene *s)
                        "with Nr %d): the wall is deformed and moved before every step of every "
                        "level from one pressure field (thesis T-60: dt_coarse = dt_fine)",
                        file, L->line, nr);
+    check_entry(s);
 }
 
 static void elastic_init(lub_model *m, lub_scene *s)
