@@ -508,9 +508,25 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
 static int open_side(const lub_mps *m, size_t i, const double c[3], double ccos)
 {
     const lub_neighbours *nb = &m->nb;
+    const lub_particles *P = m->P;
+    /* a wall particle: the solid behind it (the direction of its dummy neighbours) counts as
+     * covered, so that its open side must face the fluid side of the wall: a wall particle
+     * above a free surface has one, one under a full film has none, whatever dummies a
+     * corner of the wall lacks behind it */
+    double sd[3] = {0, 0, 0}, sn = 0;
+    if (P->kind[i] == LUB_WALL) {
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++)
+            if (nb->w[q] > 0 && P->kind[nb->j[q]] == LUB_DUMMY)
+                for (int d = 0; d < m->dim; d++) sd[d] += nb->w[q] * nb->dx[d][q];
+        sn = sqrt(sd[0] * sd[0] + sd[1] * sd[1] + sd[2] * sd[2]);
+    }
     if (m->dim == 2) {
-        double ang[128];
+        double ang[160];
         int na = 0;
+        if (sn > 0) { /* the solid half-plane, every 15 degrees */
+            const double a0 = atan2(sd[1], sd[0]);
+            for (int k = -6; k <= 6; k++) ang[na++] = remainder(a0 + k * M_PI / 12, 2 * M_PI);
+        }
         for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
             if (nb->w[q] <= 0) continue;
             if (na == (int)(sizeof ang / sizeof *ang)) return 0; /* crowded: not a surface */
@@ -537,6 +553,8 @@ static int open_side(const lub_mps *m, size_t i, const double c[3], double ccos)
         }
         double vn = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
         if (vn <= 0) continue;
+        /* an axis into the solid half (wall particle): covered */
+        if (sn > 0 && v[0] * sd[0] + v[1] * sd[1] + v[2] * sd[2] >= 0) continue;
         int empty = 1;
         for (size_t q = nb->start[i]; q < nb->end[i] && empty; q++) {
             if (nb->w[q] <= 0) continue;
@@ -570,8 +588,8 @@ static int open_side(const lub_mps *m, size_t i, const double c[3], double ccos)
  *     the particle (alone: the test of the earlier builds).
  *   pnd: the PND test alone.
  *
- * In a multi-resolution overlap (m->inside, set by models/multiResolution/opt.c) a particle where the other
- * level's particles fill the neighbourhood is not on a surface, whatever its own PND. */
+ * In a multi-resolution overlap (m->inside, set by models/multiResolution/opt.c) a particle where
+ * the other level's particles fill the neighbourhood is not on a surface, whatever its own PND. */
 static void free_surface(lub_mps *m)
 {
     lub_particles *P = m->P;
@@ -600,8 +618,7 @@ static void free_surface(lub_mps *m)
                     s = 1;
                 else
                     s = (asym <= 0 || off > asym);
-                if (s && test == LUB_SURFACE_SECTOR && P->kind[i] == LUB_FLUID)
-                    s = (uint8_t)open_side(m, i, c, ccos);
+                if (s && test == LUB_SURFACE_SECTOR) s = (uint8_t)open_side(m, i, c, ccos);
             }
         }
         m->surface[i] = s;
