@@ -877,6 +877,60 @@ static void check_memory(const lub_geometry *g, double mem)
                    g->levels[0].l0, dom, est, need / 1e9, mem / 1e9);
 }
 
+/* ---- jitter: a disordered start -------------------------------------------------------- */
+
+/* splitmix64's finaliser (Steele, Lea and Flood 2014): a bijective mix of 64 bits, used as a
+ * counter-based generator, so that a fluid particle's displacement depends only on the seed
+ * and its lattice indices (not on the order of generation or the size of the domain). */
+static uint64_t mix64(uint64_t z)
+{
+    z += 0x9e3779b97f4a7c15ULL;
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+/* Move the fluid point x of lattice indices (a, b, e) by a displacement uniform in the disk
+ * (ball) of radius jitter l0 (rejection from the square: draws outside the disk are drawn
+ * again).  A periodic direction wraps; a displacement that leaves the domain or puts the
+ * point behind a wall is drawn again too, and after 64 draws the point stays where it is.
+ * The lattice point kept wallGap l0 from the wall particles, so the moved one keeps
+ * (wallGap - jitter) l0. */
+static void jitter_point(const gen_ctx *c, long a, long b, long e, double *x)
+{
+    const lub_geometry *g = c->g;
+    const double r = g->jitter * g->levels[c->level].l0;
+    uint64_t h = mix64(g->jitter_seed);
+    h = mix64(h ^ (uint64_t)a);
+    h = mix64(h ^ (uint64_t)b);
+    h = mix64(h ^ (uint64_t)e);
+    uint64_t k = 0;
+    for (int draw = 0; draw < 64; draw++) {
+        double d[3] = {0, 0, 0}, s2 = 0;
+        for (int q = 0; q < g->dim; q++) {
+            d[q] = 2.0 * (double)(mix64(h + k++) >> 11) * 0x1.0p-53 - 1.0;
+            s2 += d[q] * d[q];
+        }
+        if (s2 > 1.0) continue;
+        double y[3] = {x[0], x[1], x[2]};
+        for (int q = 0; q < g->dim; q++) {
+            y[q] += r * d[q];
+            if (g->periodic[q]) {
+                double L = g->dmax[q] - g->dmin[q];
+                if (y[q] < g->dmin[q]) y[q] += L;
+                if (y[q] >= g->dmax[q]) y[q] -= L;
+            }
+        }
+        if (!in_domain(g, y, 0.0)) continue;
+        int solid = 0;
+        for (int w = 0; w < g->nwalls && !solid; w++)
+            solid = lub_wall_behind(&g->walls[w], y, g->dim, 0.0);
+        if (solid) continue;
+        memcpy(x, y, sizeof y);
+        return;
+    }
+}
+
 /* ---- the whole generation ------------------------------------------------------------- */
 
 /* The generation: every level in what it owns (only < 0), or level `only` in [xlo, xhi]
@@ -990,6 +1044,7 @@ static void discretise(const lub_geometry *g, lub_particles *P, int only, double
                     if (gap > 0 && grid_find(&cg, x, gap, nw) >= 0) continue;
                     for (int r = 0; r < g->nregions; r++)
                         if (in_region(g, &g->regions[r], x, tol)) rc[r]++;
+                    if (g->jitter > 0 && only < 0) jitter_point(&c, a, b, e, x);
                     push(&c, x, LUB_FLUID);
                 }
     }

@@ -20,6 +20,13 @@
  * Fluid.  Lattice points inside a region, on the fluid side of every wall, and at least
  * 0.999 wallGap l0 from every wall and dummy particle (0.999 so that round-off does not remove
  * the lattice row exactly one l0 from a wall).  A region left without particles is an error.
+ *
+ * Jitter (g->jitter > 0, lub_geometry_discretise only).  Each fluid particle is then moved
+ * from its lattice point by a displacement uniform in the disk (ball) of radius jitter l0, a
+ * function of the seed and the point's lattice indices alone (a counter-based generator), so
+ * a case gives the same particles on every machine; periodic directions wrap, and a draw
+ * that would leave the domain or enter a wall is drawn again.  A disordered start for the
+ * convergence of the operators on particles off the lattice (issue 26).
  */
 #ifndef LUB_GEOMETRY_DISCRETISE_H
 #define LUB_GEOMETRY_DISCRETISE_H

@@ -404,6 +404,23 @@ static void read_levels(lub_geometry *g, lub_node *root)
     }
 }
 
+/* A disordered start: `jitter: { amplitude, seed }`.  Below l0/2, so that a particle stays
+ * nearer its own lattice point than any other; one level only, so that no particle is
+ * moved into the x-range of another level. */
+static void read_jitter(lub_geometry *g, lub_node *root)
+{
+    lub_node *j = lub_dict_map_or(root, "jitter");
+    if (!j) return;
+    g->jitter_node = j;
+    g->jitter = lub_dict_real(j, "amplitude", (lub_range){0.0, 0.5, 0, 1});
+    g->jitter_seed = (unsigned long)lub_dict_int_or(j, "seed", 1, 0, 2147483647L);
+    if (g->nlevels > 1 && g->jitter > 0)
+        lub_node_error(j,
+                       "jitter needs a single resolution (l0), found %d levels: a jittered "
+                       "particle could leave the x-range of its level",
+                       g->nlevels);
+}
+
 /* The lattice of every level must tile each periodic direction exactly. */
 static void check_periodic(const lub_geometry *g, lub_node *pn)
 {
@@ -458,6 +475,7 @@ void lub_geometry_read(lub_geometry *g, const char *path)
     }
     g->dummy_layers = (int)lub_dict_int_or(root, "dummyLayers", 2, 0, 10);
     g->wall_gap = lub_dict_real_or(root, "wallGap", 1.0, LUB_BETWEEN(0.0, 10.0));
+    read_jitter(g, root);
 
     lub_node *wn = lub_dict_map_or(root, "walls");
     size_t nw = wn ? lub_node_size(wn) : 0;

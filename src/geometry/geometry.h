@@ -29,6 +29,7 @@
  *       - { type: layer, wall: lowerWall, thickness: 8.0e-5 }   # film on a wall
  *       - { type: box, min: [0, 0], max: [0.6, 0.3] }
  *       - { type: between, lower: lowerWall, upper: cylinder, height: 8.0e-5 }
+ *     jitter:      { amplitude: 0.25, seed: 1 }   # disordered start (optional)
  *
  * cylinder: `centre` or `lowestPoint`; fluid `outside` (default) or `inside`.
  * box, sphere: fluid `inside` or `outside` (box default inside: a tank; sphere outside).
@@ -38,6 +39,9 @@
  * end dropped; the boundary must not cross or touch itself.
  * `between ... height` fills from the lower wall up to `height` above the lower wall's
  * surface, and not inside or beyond the upper wall.
+ * `jitter` (single resolution only): every fluid particle moved from its lattice point by a
+ * random displacement, uniform in the disk (ball) of radius amplitude l0, amplitude in
+ * [0, 0.5); the same seed gives the same particles (discretise.h).
  */
 #ifndef LUB_GEOMETRY_GEOMETRY_H
 #define LUB_GEOMETRY_GEOMETRY_H
@@ -104,6 +108,9 @@ typedef struct {
     lub_wall *walls;
     int nregions;
     lub_region *regions;
+    double jitter;               /* fluid displacement radius in l0 (0: on the lattice) */
+    unsigned long jitter_seed;   /* seed of the displacements */
+    const lub_node *jitter_node; /* the `jitter` entry, or NULL */
 } lub_geometry;
 
 /* Read system/particleGenDict.yaml (path given) strictly; fatal with file:line on bad input.

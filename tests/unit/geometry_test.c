@@ -983,6 +983,104 @@ static void test_polygon_levels(void)
     lub_geometry_free(&g);
 }
 
+/* A disordered start (jitter): a channel of 20 x 20 lattice points between two planes,
+ * periodic in x, amplitude 0.25.  Each fluid particle lies within 0.25 l0 of its own
+ * lattice point (the nearest one, since the amplitude is below l0/2), off it for almost
+ * all, inside the channel and at least (1 - 0.25) l0 from the wall rows; the count is the
+ * lattice's.  The displacement is uniform in the disk of radius r = 0.25 l0: its mean is 0
+ * (standard deviation of the mean of one component r/(2 sqrt N) = 0.025 r for N = 400) and
+ * its mean square is r^2/2 (standard deviation of the mean r^2/sqrt(12 N) = 0.0144 r^2):
+ * checked to 5 standard deviations.  The same seed gives the same particles, another seed
+ * others.  Bad amplitudes and levels are refused. */
+static const char *jitter_channel(double amplitude, long seed, char *buf, size_t n)
+{
+    snprintf(buf, n,
+             "dimension: 2\nl0: 0.1\ndomain: { min: [0, -0.3], max: [2, 2.4] }\n"
+             "periodic: [x]\n"
+             "walls:\n  lower: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+             "  upper: { type: plane, point: [0, 2.1], normal: [0, -1] }\n"
+             "fluid:\n  - { type: box, min: [0, 0], max: [2, 2.1] }\n"
+             "jitter: { amplitude: %g, seed: %ld }\n",
+             amplitude, seed);
+    return buf;
+}
+
+static void test_jitter(void)
+{
+    char text[1024];
+    lub_geometry g, g2, g3;
+    lub_particles P, P2, P3;
+    generate(jitter_channel(0.25, 7, text, sizeof text), &g, &P, NULL);
+    CHECK_NEAR(g.jitter, 0.25, 0);
+    CHECK(g.jitter_seed == 7);
+    CHECK(count_of(&P, LUB_FLUID, -1) == 400);
+    CHECK(count_of(&P, LUB_WALL, -1) == 40);
+    const double l0 = 0.1, r = 0.25 * l0;
+    double sx = 0, sy = 0, s2 = 0, dmax = 0, ymin = 1e9, ymax = -1e9;
+    int n = 0, on_lattice = 0, outside = 0;
+    for (size_t i = 0; i < P.n; i++) {
+        if (P.kind[i] != LUB_FLUID) continue;
+        double x = P.x[0][i], y = P.x[1][i];
+        if (x < 0 || x >= 2) outside++;
+        /* nearest lattice point: columns at (i + 1/2) l0 (periodic), rows at k l0 */
+        double dx = x - (floor(x / l0) + 0.5) * l0, dy = y - round(y / l0) * l0;
+        double d = sqrt(dx * dx + dy * dy);
+        dmax = fmax(dmax, d);
+        if (d < 1e-3 * r) on_lattice++;
+        sx += dx, sy += dy, s2 += d * d, n++;
+        ymin = fmin(ymin, y), ymax = fmax(ymax, y);
+    }
+    printf("  jitter 0.25: %d particles, largest displacement %.4f l0, mean (%.4f, %.4f) r, "
+           "mean square %.4f r^2, y in [%.4f, %.4f]\n",
+           n, dmax / l0, sx / n / r, sy / n / r, s2 / n / (r * r), ymin, ymax);
+    CHECK(outside == 0);
+    CHECK(dmax <= r * (1 + 1e-12));
+    CHECK(on_lattice <= 2);
+    CHECK(fabs(sx / n) < 0.125 * r && fabs(sy / n) < 0.125 * r);
+    CHECK(fabs(s2 / n / (r * r) - 0.5) < 0.072);
+    CHECK(ymin >= 0.75 * l0 - 1e-12 && ymax <= 2.1 - 0.75 * l0 + 1e-12);
+
+    generate(jitter_channel(0.25, 7, text, sizeof text), &g2, &P2, NULL);
+    generate(jitter_channel(0.25, 8, text, sizeof text), &g3, &P3, NULL);
+    int same = P2.n == P.n, differ = 0;
+    for (size_t i = 0; same && i < P.n; i++)
+        for (int d = 0; d < 2; d++) {
+            if (P2.x[d][i] != P.x[d][i]) same = 0;
+            if (P3.x[d][i] != P.x[d][i]) differ++;
+        }
+    CHECK(same);
+    CHECK(differ > 700);
+    lub_particles_free(&P3);
+    lub_geometry_free(&g3);
+    lub_particles_free(&P2);
+    lub_geometry_free(&g2);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+
+    /* amplitude 0: the lattice itself */
+    generate(jitter_channel(0, 7, text, sizeof text), &g, &P, NULL);
+    int off = 0;
+    for (size_t i = 0; i < P.n; i++)
+        if (P.kind[i] == LUB_FLUID) {
+            double qx = P.x[0][i] / l0 - 0.5, qy = P.x[1][i] / l0;
+            if (fabs(qx - round(qx)) > 1e-9 || fabs(qy - round(qy)) > 1e-9) off++;
+        }
+    CHECK(off == 0);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+
+    CHECK_BAD(jitter_channel(0.5, 7, text, sizeof text), 10, "'jitter.amplitude' must be");
+    CHECK_BAD(jitter_channel(-0.1, 7, text, sizeof text), 10, "'jitter.amplitude' must be");
+    CHECK_BAD(jitter_channel(0.2, -1, text, sizeof text), 10, "'jitter.seed' must be");
+    CHECK_BAD("dimension: 2\nlevels:\n  - { l0: 0.1, region: [0, 0.5] }\n  - { l0: 0.2 }\n"
+              "domain: { min: [0, 0], max: [1, 1] }\n"
+              "jitter: { amplitude: 0.2 }\n",
+              6, "jitter needs a single resolution");
+    CHECK_BAD("dimension: 2\nl0: 0.1\ndomain: { min: [0, 0], max: [1, 1] }\n"
+              "jitter: { amplitude: 0.2, sed: 3 }\n",
+              4, "unknown key 'sed'");
+}
+
 int main(void)
 {
     RUN(test_read_wedge);
@@ -1007,6 +1105,7 @@ int main(void)
     RUN(test_polygon_concave);
     RUN(test_polygon_pad);
     RUN(test_polygon_levels);
+    RUN(test_jitter);
     unlink(tmp_path);
     return test_summary();
 }
