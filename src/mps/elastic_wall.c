@@ -122,6 +122,8 @@ static int read_state(lub_mps_elastic *w, const char *path)
     lub_dict_find(root, "step");
     lub_dict_find(root, "deltaT");
     lub_dict_find(root, "multiResolution");
+    lub_dict_find(root, "writeOrigin");
+    lub_dict_find(root, "writeOriginStep");
     lub_node *s = lub_dict_map_or(root, "elasticWall");
     if (s) {
         w->h0 = lub_dict_real(s, "h0", LUB_ANY);
