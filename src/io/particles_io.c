@@ -1353,7 +1353,7 @@ void lub_xdmf_series_scan(lub_xdmf_series *s, const lub_case *c)
         s->n++;
     }
     free(times);
-    qsort(s->e, s->n, sizeof *s->e, cmp_entry);
+    if (s->n > 1) qsort(s->e, s->n, sizeof *s->e, cmp_entry); /* (none: s->e is NULL) */
 }
 
 size_t lub_xdmf_series_write(const lub_xdmf_series *s)
