@@ -145,11 +145,16 @@ void lub_args_parse(lub_args *a, int argc, char **argv, const lub_program_info *
                 *(int *)o->dest = 1;
                 continue;
             }
-            if (i + 1 >= argc) lub_fatal("option '%s' expects %s", o->name, o->arg ? o->arg : "a value");
+            if (i + 1 >= argc)
+                lub_fatal("option '%s' expects %s", o->name, o->arg ? o->arg : "a value");
             const char *val = argv[++i];
             switch (o->type) {
-            case LUB_OPT_STR: *(const char **)o->dest = val; break;
-            case LUB_OPT_MULTI: lub_strlist_push((lub_strlist *)o->dest, val); break;
+            case LUB_OPT_STR:
+                *(const char **)o->dest = val;
+                break;
+            case LUB_OPT_MULTI:
+                lub_strlist_push((lub_strlist *)o->dest, val);
+                break;
             case LUB_OPT_REAL:
                 if (lub_parse_real(val, (double *)o->dest))
                     lub_fatal("option '%s' expects a real number, found '%s'", o->name, val);
@@ -158,7 +163,8 @@ void lub_args_parse(lub_args *a, int argc, char **argv, const lub_program_info *
                 if (lub_parse_int(val, (long *)o->dest))
                     lub_fatal("option '%s' expects an integer, found '%s'", o->name, val);
                 break;
-            default: break;
+            default:
+                break;
             }
         }
         if (done) continue;
@@ -173,6 +179,10 @@ void lub_args_parse(lub_args *a, int argc, char **argv, const lub_program_info *
         if (info->has_case && strcmp(name, "-case") == 0) {
             if (i + 1 >= argc) lub_fatal("option '-case' expects DIR");
             a->case_dir = argv[++i];
+            /* an empty name (a variable that was not set) would run the current directory */
+            if (!*a->case_dir)
+                lub_fatal("option '-case' expects DIR, found an empty name (the current "
+                          "directory is -case .)");
             continue;
         }
         if (info->time_selection && strcmp(name, "-time") == 0) {
@@ -195,7 +205,9 @@ void lub_args_parse(lub_args *a, int argc, char **argv, const lub_program_info *
         for (size_t k = 0; k < NCOMMON; k++)
             if (common_enabled(info, (int)k)) names[n++] = common[k].name;
         const char *near = lub_closest(name, names, n);
-        if (near) lub_fatal("unknown option '%s' (did you mean '%s'?); see %s -help", arg, near, info->name);
+        if (near)
+            lub_fatal("unknown option '%s' (did you mean '%s'?); see %s -help", arg, near,
+                      info->name);
         lub_fatal("unknown option '%s'; see %s -help", arg, info->name);
     }
     if (a->npos < info->min_args || (info->max_args >= 0 && a->npos > info->max_args)) {

@@ -49,20 +49,39 @@ size_t lub_case_select_times(const lub_case *c, const char *list, int latest, in
 
 /* Create directories along a path (mkdir -p).  0 on success. */
 int lub_mkdir_p(const char *path);
+/* fsync a directory (after a rename into it: the rename is durable only then).  0 on
+ * success, else -1 with errno. */
+int lub_fsync_dir(const char *dir);
 /* Remove a directory tree.  0 on success. */
 int lub_rm_rf(const char *path);
 
 /* Atomic time folder: begin creates "<root>/.<name>.tmp<pid>" and returns its path in dir;
- * files are written inside; commit renames it to "<root>/<name>" (replacing an existing
- * folder of that name only after the new one is complete).  Fatal (exit 2) on I/O errors. */
+ * files are written inside (each flushed to disk); commit flushes the folder and its
+ * sub-folders, renames it to "<root>/<name>" (replacing an existing folder of that name only
+ * after the new one is complete) and flushes the case directory.  Fatal (exit 2) on I/O
+ * errors. */
 void lub_timedir_begin(const lub_case *c, const char *name, char *dir);
 void lub_timedir_commit(const lub_case *c, const char *name, const char *dir);
 
-/* Atomic file: open writes "<path>.tmp<pid>", close flushes, fsyncs and renames over path.
- * lub_atomic_close returns 0 on success; on failure removes the temporary and returns -1. */
+/* Remove what a program killed while writing (kill -9, a full disk) left in the case: the
+ * temporary names of lub_timedir_begin/commit, lub_atomic_open and lub_particles_write,
+ * which carry the writer's pid: hidden ".<time>.tmp<pid>" folders, "<file>.tmp<pid>" files
+ * in the case, in its time folders (and their uniform/) and under postProcessing/.  A
+ * ".<time>.old<pid>" folder is the previous copy of a time that was being replaced: it is
+ * put back when the time folder is missing, else removed.  Only names whose process is gone
+ * are touched (another program may be writing).  Each is reported (lub_message); returns
+ * the count. */
+size_t lub_case_clean(const lub_case *c);
+
+/* Atomic file: open writes "<path>.tmp<pid>", close flushes, fsyncs and renames over path
+ * (and fsyncs its directory).  A path that exists and is not a regular file (/dev/null, a
+ * FIFO) is written in place: a rename would replace the device.  lub_atomic_close returns
+ * 0 on success; on failure removes the temporary and returns -1 with errno. */
 typedef struct {
     FILE *fp;
     char path[LUB_PATH_MAX], tmp[LUB_PATH_MAX];
+    int sync_dir; /* 1 (set by open): fsync the directory after the rename; 0 for a file in
+                     a temporary time folder, whose directories lub_timedir_commit syncs */
 } lub_atomic_file;
 FILE *lub_atomic_open(lub_atomic_file *f, const char *path); /* NULL on failure (errno) */
 int lub_atomic_close(lub_atomic_file *f);

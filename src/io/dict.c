@@ -24,13 +24,13 @@ struct lub_node {
     const lub_dict *dict;
     lub_node *parent;
     int line, col;
-    char *text;       /* scalar text; for mapping entries the key is in keys[] */
-    size_t n;         /* items (sequence) or entries (mapping) */
-    lub_node **items; /* sequence items, or mapping values */
-    lub_node **keys;  /* mapping keys (scalar nodes) */
-    char *label;      /* this node's name in its parent: key text or item index */
-    char *path;       /* dotted path, built on demand */
-    int opened;       /* a lookup was made in this mapping */
+    char *text;           /* scalar text; for mapping entries the key is in keys[] */
+    size_t n;             /* items (sequence) or entries (mapping) */
+    lub_node **items;     /* sequence items, or mapping values */
+    lub_node **keys;      /* mapping keys (scalar nodes) */
+    char *label;          /* this node's name in its parent: key text or item index */
+    char *path;           /* dotted path, built on demand */
+    int opened;           /* a lookup was made in this mapping */
     unsigned char *known; /* per entry: the program asked for this key */
     char **asked;         /* keys asked for (also absent ones), for suggestions */
     size_t nasked, capasked;
@@ -88,7 +88,15 @@ static _Noreturn void fatal_node_raw(const lub_dict *d, int line, int col, const
 typedef struct {
     lub_dict *d;
     yaml_document_t *doc;
+    unsigned char *seen; /* per document node: converted once already (a later visit is an alias) */
+    size_t expanded;     /* nodes built by repeated visits: the expansion of aliases */
 } build_ctx;
+
+/* libyaml's composer keeps an alias as a reference to its anchored node; the tree built here
+ * copies it at every use, so nested aliases multiply (9 lines of "&a [*b, *b, ...]" make
+ * 10^9 nodes, all the memory there is).  libyaml leaves the limit to the application: a
+ * dictionary repeats a setting or a few with aliases, so the copies are capped. */
+#define LUB_DICT_MAX_ALIAS_NODES 10000
 
 static lub_node *convert(build_ctx *ctx, yaml_node_t *y, lub_node *parent, int depth,
                          lub_node **slot)
@@ -97,6 +105,13 @@ static lub_node *convert(build_ctx *ctx, yaml_node_t *y, lub_node *parent, int d
     if (depth > 64)
         fatal_node_raw(d, (int)y->start_mark.line + 1, (int)y->start_mark.column + 1,
                        "nesting deeper than 64 levels (recursive alias?)");
+    const size_t id = (size_t)(y - ctx->doc->nodes.start);
+    if (ctx->seen[id] && ++ctx->expanded > LUB_DICT_MAX_ALIAS_NODES)
+        fatal_node_raw(d, (int)y->start_mark.line + 1, (int)y->start_mark.column + 1,
+                       "YAML aliases (*name) expand to more than %d values: an alias repeats "
+                       "its anchored part (&name) at every use, and nested ones multiply",
+                       LUB_DICT_MAX_ALIAS_NODES);
+    ctx->seen[id] = 1;
     switch (y->type) {
     case YAML_SCALAR_NODE: {
         lub_node *n = node_new(d, parent, LUB_NODE_SCALAR, y);
@@ -141,8 +156,8 @@ static lub_node *convert(build_ctx *ctx, yaml_node_t *y, lub_node *parent, int d
             for (size_t j = 0; j < i; j++)
                 if (strcmp(n->keys[j]->text, n->keys[i]->text) == 0)
                     fatal_node_raw(d, n->keys[i]->line, n->keys[i]->col,
-                                   "duplicate key '%s' (first given at line %d)",
-                                   n->keys[i]->text, n->keys[j]->line);
+                                   "duplicate key '%s' (first given at line %d)", n->keys[i]->text,
+                                   n->keys[j]->line);
             lub_node *val = convert(ctx, v, n, depth + 1, &n->items[i]);
             val->label = lub_strdup(n->keys[i]->text);
         }
@@ -157,13 +172,54 @@ static lub_node *convert(build_ctx *ctx, yaml_node_t *y, lub_node *parent, int d
 static const char *yaml_error_name(yaml_error_type_t e)
 {
     switch (e) {
-    case YAML_MEMORY_ERROR: return "out of memory";
-    case YAML_READER_ERROR: return "unreadable text";
+    case YAML_MEMORY_ERROR:
+        return "out of memory";
+    case YAML_READER_ERROR:
+        return "unreadable text";
     case YAML_SCANNER_ERROR:
     case YAML_PARSER_ERROR:
-    case YAML_COMPOSER_ERROR: return "YAML syntax error";
-    default: return "YAML error";
+    case YAML_COMPOSER_ERROR:
+        return "YAML syntax error";
+    default:
+        return "YAML error";
     }
+}
+
+/* Line and column (1-based) of a byte offset into the text. */
+static void offset_position(const unsigned char *text, size_t len, size_t offset, int *line,
+                            int *col)
+{
+    *line = 1;
+    *col = 1;
+    for (size_t i = 0; i < offset && i < len; i++) {
+        if (text[i] == '\n') {
+            ++*line;
+            *col = 1;
+        } else if ((text[i] & 0xC0) != 0x80) { /* a character, not a UTF-8 continuation */
+            ++*col;
+        }
+    }
+}
+
+/* Fatal error for a failed yaml_parser_load, after releasing the parser. */
+static _Noreturn void load_error(lub_dict *d, yaml_parser_t *parser, const unsigned char *text,
+                                 size_t len)
+{
+    char msg[1024];
+    int line = (int)parser->problem_mark.line + 1, col = (int)parser->problem_mark.column + 1;
+    /* libyaml's reader (bad UTF-8, a control character such as NUL) gives the position as
+     * a byte offset and leaves the mark at the start */
+    if (parser->error == YAML_READER_ERROR)
+        offset_position(text, len, parser->problem_offset, &line, &col);
+    if (parser->error == YAML_READER_ERROR && parser->problem_value >= 0)
+        snprintf(msg, sizeof msg, "%s: %s (byte 0x%02x)", yaml_error_name(parser->error),
+                 parser->problem ? parser->problem : "?", (unsigned)parser->problem_value);
+    else
+        snprintf(msg, sizeof msg, "%s: %s%s%s", yaml_error_name(parser->error),
+                 parser->problem ? parser->problem : "?", parser->context ? " " : "",
+                 parser->context ? parser->context : "");
+    yaml_parser_delete(parser);
+    fatal_node_raw(d, line, col, "%s", msg);
 }
 
 /* Parse text of given length into d->root.  Errors are fatal; resources are released first. */
@@ -173,15 +229,23 @@ static void parse_into(lub_dict *d, const unsigned char *text, size_t len)
     yaml_document_t doc;
     if (!yaml_parser_initialize(&parser)) lub_fatal_run("libyaml: cannot initialise parser");
     yaml_parser_set_input_string(&parser, text, len);
-    if (!yaml_parser_load(&parser, &doc)) {
-        char msg[1024];
-        int line = (int)parser.problem_mark.line + 1, col = (int)parser.problem_mark.column + 1;
-        snprintf(msg, sizeof msg, "%s: %s%s%s", yaml_error_name(parser.error),
-                 parser.problem ? parser.problem : "?", parser.context ? " " : "",
-                 parser.context ? parser.context : "");
-        yaml_parser_delete(&parser);
-        fatal_node_raw(d, line, col, "%s", msg);
+    if (!yaml_parser_load(&parser, &doc)) load_error(d, &parser, text, len);
+    /* A dictionary is one document: keys after a second '---' would be silently ignored. */
+    yaml_document_t next;
+    if (!yaml_parser_load(&parser, &next)) {
+        yaml_document_delete(&doc);
+        load_error(d, &parser, text, len);
     }
+    if (yaml_document_get_root_node(&next)) {
+        int line = (int)next.start_mark.line + 1, col = (int)next.start_mark.column + 1;
+        yaml_document_delete(&next);
+        yaml_document_delete(&doc);
+        yaml_parser_delete(&parser);
+        fatal_node_raw(d, line, col,
+                       "a second YAML document begins here ('---'): a dictionary is one "
+                       "document, whose entries all belong to the first one");
+    }
+    yaml_document_delete(&next);
     yaml_parser_delete(&parser);
 
     yaml_node_t *top = yaml_document_get_root_node(&doc);
@@ -198,12 +262,15 @@ static void parse_into(lub_dict *d, const unsigned char *text, size_t len)
     }
     /* A catcher makes sure the document is released if conversion fails. */
     lub_catcher c;
+    build_ctx ctx = {d, &doc, NULL, 0};
+    ctx.seen = lub_calloc((size_t)(doc.nodes.top - doc.nodes.start) + 1, 1);
     if (lub_error_catch(&c) == 0) {
-        build_ctx ctx = {d, &doc};
         convert(&ctx, top, NULL, 0, &d->root);
         lub_error_uncatch();
+        free(ctx.seen);
         yaml_document_delete(&doc);
     } else {
+        free(ctx.seen);
         yaml_document_delete(&doc);
         node_free(d->root);
         d->root = NULL;
@@ -287,8 +354,14 @@ static lub_dict *read_file(const char *path, int optional)
     return d;
 }
 
-lub_dict *lub_dict_read(const char *path) { return read_file(path, 0); }
-lub_dict *lub_dict_read_optional(const char *path) { return read_file(path, 1); }
+lub_dict *lub_dict_read(const char *path)
+{
+    return read_file(path, 0);
+}
+lub_dict *lub_dict_read_optional(const char *path)
+{
+    return read_file(path, 1);
+}
 
 lub_dict *lub_dict_parse(const char *name, const char *text)
 {
@@ -303,20 +376,43 @@ void lub_dict_free(lub_dict *d)
     free(d);
 }
 
-lub_node *lub_dict_root(const lub_dict *d) { return d->root; }
-const char *lub_dict_path(const lub_dict *d) { return d->path; }
+lub_node *lub_dict_root(const lub_dict *d)
+{
+    return d->root;
+}
+const char *lub_dict_path(const lub_dict *d)
+{
+    return d->path;
+}
 
 /* ---- nodes ---------------------------------------------------------------------------- */
 
-lub_node_type lub_node_type_of(const lub_node *n) { return n->type; }
-int lub_node_line(const lub_node *n) { return n->line; }
-int lub_node_col(const lub_node *n) { return n->col; }
-const char *lub_node_file(const lub_node *n) { return n->dict->path; }
-size_t lub_node_size(const lub_node *n) { return n->type == LUB_NODE_SCALAR ? 0 : n->n; }
+lub_node_type lub_node_type_of(const lub_node *n)
+{
+    return n->type;
+}
+int lub_node_line(const lub_node *n)
+{
+    return n->line;
+}
+int lub_node_col(const lub_node *n)
+{
+    return n->col;
+}
+const char *lub_node_file(const lub_node *n)
+{
+    return n->dict->path;
+}
+size_t lub_node_size(const lub_node *n)
+{
+    return n->type == LUB_NODE_SCALAR ? 0 : n->n;
+}
 
 static const char *type_name(lub_node_type t)
 {
-    return t == LUB_NODE_SCALAR ? "a single value" : t == LUB_NODE_SEQUENCE ? "a list" : "a mapping";
+    return t == LUB_NODE_SCALAR     ? "a single value"
+           : t == LUB_NODE_SEQUENCE ? "a list"
+                                    : "a mapping";
 }
 
 _Noreturn void lub_node_error(const lub_node *n, const char *fmt, ...)
@@ -411,8 +507,8 @@ long lub_node_int(const lub_node *n, long lo, long hi)
     if (v < lo || v > hi) {
         if (hi == LONG_MAX)
             lub_node_error(n, "'%s' must be >= %ld, found '%s'", lub_node_path(n), lo, s);
-        lub_node_error(n, "'%s' must be between %ld and %ld, found '%s'", lub_node_path(n), lo,
-                       hi, s);
+        lub_node_error(n, "'%s' must be between %ld and %ld, found '%s'", lub_node_path(n), lo, hi,
+                       s);
     }
     return v;
 }
@@ -455,15 +551,17 @@ lub_node *lub_dict_find(lub_node *map, const char *key)
     return NULL;
 }
 
-int lub_dict_has(lub_node *map, const char *key) { return lub_dict_find(map, key) != NULL; }
+int lub_dict_has(lub_node *map, const char *key)
+{
+    return lub_dict_find(map, key) != NULL;
+}
 
 lub_node *lub_dict_get(lub_node *map, const char *key)
 {
     lub_node *v = lub_dict_find(map, key);
     if (!v) {
         const char *p = lub_node_path(map);
-        if (*p)
-            lub_node_error(map, "missing required key '%s' in '%s'", key, p);
+        if (*p) lub_node_error(map, "missing required key '%s' in '%s'", key, p);
         lub_node_error(map, "missing required key '%s'", key);
     }
     return v;
@@ -532,15 +630,21 @@ int lub_dict_choice(lub_node *map, const char *key, const char *const *choices, 
 
 static int read_vec(lub_node *v, double *out, int nmin, int nmax, lub_range r)
 {
-    if (v->type != LUB_NODE_SEQUENCE)
-        lub_node_error(v, "'%s' expects a list of %d%s%d numbers like [0, 1], found %s '%s'",
-                       lub_node_path(v), nmin, nmin == nmax ? "" : " to ", nmax,
-                       type_name(v->type), v->type == LUB_NODE_SCALAR ? v->text : "...");
+    if (v->type != LUB_NODE_SEQUENCE) {
+        char count[64];
+        if (nmin == nmax)
+            snprintf(count, sizeof count, "%d", nmin);
+        else
+            snprintf(count, sizeof count, "%d to %d", nmin, nmax);
+        lub_node_error(v, "'%s' expects a list of %s numbers like [0, 1], found %s '%s'",
+                       lub_node_path(v), count, type_name(v->type),
+                       v->type == LUB_NODE_SCALAR ? v->text : "...");
+    }
     if ((int)v->n < nmin || (int)v->n > nmax) {
         if (nmin == nmax)
             lub_node_error(v, "'%s' expects %d numbers, found %zu", lub_node_path(v), nmin, v->n);
-        lub_node_error(v, "'%s' expects %d to %d numbers, found %zu", lub_node_path(v), nmin,
-                       nmax, v->n);
+        lub_node_error(v, "'%s' expects %d to %d numbers, found %zu", lub_node_path(v), nmin, nmax,
+                       v->n);
     }
     for (size_t i = 0; i < v->n; i++) out[i] = lub_node_real(v->items[i], r);
     return (int)v->n;
@@ -551,8 +655,7 @@ int lub_dict_vec(lub_node *map, const char *key, double *out, int nmin, int nmax
     return read_vec(lub_dict_get(map, key), out, nmin, nmax, r);
 }
 
-int lub_dict_vec_or(lub_node *map, const char *key, double *out, int nmin, int nmax,
-                    lub_range r)
+int lub_dict_vec_or(lub_node *map, const char *key, double *out, int nmin, int nmax, lub_range r)
 {
     lub_node *v = lub_dict_find(map, key);
     return v ? read_vec(v, out, nmin, nmax, r) : 0;
@@ -599,8 +702,7 @@ static void finish_node(const lub_node *n)
             char where[512] = "";
             if (*p) snprintf(where, sizeof where, " in '%s'", p);
             if (near)
-                lub_node_error(k, "unknown key '%s'%s (did you mean '%s'?)", k->text, where,
-                               near);
+                lub_node_error(k, "unknown key '%s'%s (did you mean '%s'?)", k->text, where, near);
             char list[1024] = "";
             size_t len = 0;
             for (size_t j = 0; j < n->nasked && len < sizeof list; j++)

@@ -228,7 +228,9 @@ void lub_output_open(lub_output *o, const char *path)
         return;
     }
     lub_atomic_file f;
-    if (!lub_atomic_open(&f, path)) lub_fatal("cannot write '%s': %s", path, strerror(errno));
+    /* a write that cannot happen (a read-only or full file system) is a failed run, exit 2,
+     * as when lubFoam cannot write its tables */
+    if (!lub_atomic_open(&f, path)) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
     o->fp = f.fp;
     o->atomic = 1;
     snprintf(o->path, sizeof o->path, "%s", f.path);
@@ -249,6 +251,7 @@ void lub_output_close(lub_output *o)
     f.fp = o->fp;
     snprintf(f.path, sizeof f.path, "%s", o->path);
     snprintf(f.tmp, sizeof f.tmp, "%s", o->tmp);
+    f.sync_dir = 1;
     o->fp = NULL;
     if (lub_atomic_close(&f) != 0)
         lub_fatal_run("error writing '%s': %s", o->path, strerror(errno));

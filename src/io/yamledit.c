@@ -357,8 +357,12 @@ static void text_adopt(lub_yaml_text *y, const char *name, char *text, size_t le
         lub_fatal_at(name, 0, 0, "the file is UTF-16; dictionaries must be UTF-8");
     }
     if (strlen(text) != len) {
+        size_t at = strlen(text);
+        int line = 1, col = 1;
+        for (size_t i = 0; i < at; i++)
+            line += text[i] == '\n', col = text[i] == '\n' ? 1 : col + 1;
         free(text);
-        lub_fatal_at(name, 0, 0, "NUL byte in the file: not a YAML text");
+        lub_fatal_at(name, line, col, "NUL byte in the file: not a YAML text");
     }
     ytree t;
     if (!tree_parse(&t, text, len)) {
@@ -367,6 +371,17 @@ static void text_adopt(lub_yaml_text *y, const char *name, char *text, size_t le
         syntax_fatal(name, &t);
     }
     tree_free(&t);
+    /* the file as every program reads it (dict.c): an edit must not be the only thing that
+     * accepts a file the programs reject (a duplicate key, a second document, an alias
+     * bomb) */
+    lub_catcher c;
+    if (lub_error_catch(&c) == 0) {
+        lub_dict_free(lub_dict_parse(name, text));
+        lub_error_uncatch();
+    } else {
+        free(text);
+        lub_fatal_at(NULL, 0, 0, "%s", c.message);
+    }
     y->text = text;
     y->len = len;
 }

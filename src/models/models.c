@@ -20,6 +20,8 @@ void lub_models_declare_state(lub_node *root)
     lub_dict_find(root, "time");
     lub_dict_find(root, "step");
     lub_dict_find(root, "deltaT");
+    lub_dict_find(root, "writeOrigin"); /* the write grid of the case's first run */
+    lub_dict_find(root, "writeOriginStep");
     for (int i = 0; lub_model_types[i]; i++) lub_dict_find(root, lub_model_types[i]->name);
     for (int i = 0; other_keys[i]; i++) lub_dict_find(root, other_keys[i]);
 }

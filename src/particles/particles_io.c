@@ -36,7 +36,8 @@ typedef struct {
     int failed;
     H5E_auto2_t old_func; /* HDF5 automatic error printing, restored on exit */
     void *old_data;
-    void *buf;     /* scratch buffer, freed on every exit */
+    void *buf;     /* scratch buffer, freed on every exit when owned */
+    int own_buf;   /* buf was allocated for this call (a writer's buffers are kept) */
     hid_t fapl;    /* file access property list */
     hid_t file;    /* the open file */
     int have_data; /* P holds storage that must be freed on failure */
@@ -59,17 +60,21 @@ static void ctx_begin(h5ctx *c)
     H5Eset_auto2(H5E_DEFAULT, NULL, NULL);
 }
 
+static int fail_h5(h5ctx *c, const char *fmt, ...) __attribute__((format(printf, 2, 3)));
+
 /* Release everything; returns whether a failure was recorded. */
 static int ctx_end(h5ctx *c)
 {
+    errno = 0;
     if (c->file >= 0 && H5Fclose(c->file) < 0 && !c->failed) {
-        c->failed = 1;
-        snprintf(c->msg, sizeof c->msg, "cannot close the file");
+        /* closing flushes what HDF5 held back: a full disk shows here; say why */
+        const int e = errno;
+        fail_h5(c, "cannot close the file%s%s", e ? ": " : "", e ? strerror(e) : "");
     }
     c->file = H5I_INVALID_HID;
     if (c->fapl >= 0) H5Pclose(c->fapl);
     c->fapl = H5I_INVALID_HID;
-    free(c->buf);
+    if (c->own_buf) free(c->buf);
     c->buf = NULL;
     H5Eclear2(H5E_DEFAULT);
     H5Eset_auto2(H5E_DEFAULT, c->old_func, c->old_data);
@@ -89,6 +94,8 @@ static herr_t reason_cb(unsigned n, const H5E_error2_t *e, void *data)
     (void)n;
     if (!r->found && e->desc && e->desc[0]) {
         snprintf(r->buf, r->size, "%s", e->desc);
+        for (char *q = r->buf; *q; q++) /* one line (HDF5's ctime() ends in a newline) */
+            if (*q == '\n') *q = ' ';
         r->found = 1;
     }
     return 0;
@@ -191,18 +198,35 @@ static int write_attr_string(h5ctx *c, hid_t loc, const char *name, const char *
     return rc;
 }
 
-/* One contiguous dataset of n rows and ncols columns (ncols 1: rank 1). */
+/* Rows per chunk of a dataset: HDF5's Fletcher32 checksum filter works on chunked
+ * datasets only; 65536 rows (1.5 MB of positions) keep the chunk index small and a
+ * chunk's checksum cheap. */
+enum { CHUNK_ROWS = 65536 };
+
+/* One dataset of n rows and ncols columns (ncols 1: rank 1).  Chunked with HDF5's
+ * Fletcher32 checksum filter, so that a damaged byte in the data (a flipped bit on a disk,
+ * a copy cut short) is found when it is read, not computed with: HDF5 verifies every
+ * chunk's checksum on reading.  An empty dataset cannot be chunked and holds nothing to
+ * check: contiguous. */
 static int write_dataset(h5ctx *c, hid_t g, const char *name, hid_t filetype, hid_t memtype,
                          size_t n, int ncols, const void *data)
 {
     hsize_t dims[2] = {(hsize_t)n, (hsize_t)ncols};
+    hsize_t chunk[2] = {(hsize_t)(n < CHUNK_ROWS ? n : CHUNK_ROWS), (hsize_t)ncols};
     hid_t s = H5Screate_simple(ncols > 1 ? 2 : 1, dims, NULL), d = H5I_INVALID_HID;
+    hid_t dcpl = H5I_INVALID_HID;
     int rc = -1;
     if (s < 0) {
         fail_h5(c, "cannot create the dataspace of '%s'", name);
         goto out;
     }
-    d = H5Dcreate2(g, name, filetype, s, H5P_DEFAULT, H5P_DEFAULT, H5P_DEFAULT);
+    if ((dcpl = H5Pcreate(H5P_DATASET_CREATE)) < 0 ||
+        (n > 0 &&
+         (H5Pset_chunk(dcpl, ncols > 1 ? 2 : 1, chunk) < 0 || H5Pset_fletcher32(dcpl) < 0))) {
+        fail_h5(c, "cannot set up the checksum of dataset '%s'", name);
+        goto out;
+    }
+    d = H5Dcreate2(g, name, filetype, s, H5P_DEFAULT, dcpl, H5P_DEFAULT);
     if (d < 0) {
         fail_h5(c, "cannot create dataset '%s'", name);
         goto out;
@@ -213,6 +237,7 @@ static int write_dataset(h5ctx *c, hid_t g, const char *name, hid_t filetype, hi
     }
     rc = 0;
 out:
+    close_id(&dcpl, H5Pclose);
     close_id(&d, H5Dclose);
     close_id(&s, H5Sclose);
     return rc;
@@ -225,14 +250,37 @@ static hid_t make_group(h5ctx *c, hid_t loc, const char *name)
     return g;
 }
 
-/* Interleave three component arrays into an n x 3 buffer. */
-static void interleave(double *buf, double *const comp[3], size_t n)
+/* The rows of a file are the particles in id order (rank[r].index is the particle of row
+ * r): a reader that is not ours (meshio's time series, a script pairing two times row by
+ * row) finds the same particle in the same row at every time where the set is the same,
+ * whatever order the solver keeps them in. */
+static void gather3(double *buf, double *const comp[3], const lub_particles_rank *rank, size_t n)
 {
-    for (size_t i = 0; i < n; i++)
-        for (int d = 0; d < 3; d++) buf[3 * i + d] = comp[d][i];
+    for (size_t r = 0; r < n; r++)
+        for (int d = 0; d < 3; d++) buf[3 * r + d] = comp[d][rank[r].index];
 }
 
-static int write_contents(h5ctx *c, const lub_particles *P)
+static void gather_f64(double *buf, const double *v, const lub_particles_rank *rank, size_t n)
+{
+    for (size_t r = 0; r < n; r++) buf[r] = v[rank[r].index];
+}
+
+static void gather_u8(uint8_t *buf, const uint8_t *v, const lub_particles_rank *rank, size_t n)
+{
+    for (size_t r = 0; r < n; r++) buf[r] = v[rank[r].index];
+}
+
+static void gather_u16(uint16_t *buf, const uint16_t *v, const lub_particles_rank *rank, size_t n)
+{
+    for (size_t r = 0; r < n; r++) buf[r] = v[rank[r].index];
+}
+
+static void gather_u64(uint64_t *buf, const uint64_t *v, const lub_particles_rank *rank, size_t n)
+{
+    for (size_t r = 0; r < n; r++) buf[r] = v[rank[r].index];
+}
+
+static int write_contents(h5ctx *c, const lub_particles *P, const lub_particles_rank *rank)
 {
     hid_t f = c->file, g = H5I_INVALID_HID, t = H5I_INVALID_HID;
     int64_t step = P->step;
@@ -268,21 +316,46 @@ static int write_contents(h5ctx *c, const lub_particles *P)
     if ((g = make_group(c, f, "fields")) < 0) goto out;
     size_t n = P->n;
     double *buf = c->buf;
-    interleave(buf, P->x, n);
+    gather3(buf, P->x, rank, n);
     if (write_dataset(c, g, "position", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 3, buf)) goto out;
-    interleave(buf, P->u, n);
-    if (write_dataset(c, g, "velocity", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 3, buf) ||
-        write_dataset(c, g, "pressure", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 1, P->p) ||
-        write_dataset(c, g, "kind", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 1, P->kind) ||
-        write_dataset(c, g, "patch", H5T_STD_U16LE, H5T_NATIVE_UINT16, n, 1, P->patch) ||
-        write_dataset(c, g, "level", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 1, P->level) ||
-        write_dataset(c, g, "id", H5T_STD_U64LE, H5T_NATIVE_UINT64, n, 1, P->id))
-        goto out;
-    for (int e = 0; e < P->nextra; e++)
-        if (write_dataset(c, g, P->extra[e].name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 1,
-                          P->extra[e].v))
+    gather3(buf, P->u, rank, n);
+    if (write_dataset(c, g, "velocity", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 3, buf)) goto out;
+    gather_f64(buf, P->p, rank, n);
+    if (write_dataset(c, g, "pressure", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 1, buf)) goto out;
+    gather_u8(c->buf, P->kind, rank, n);
+    if (write_dataset(c, g, "kind", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 1, c->buf)) goto out;
+    gather_u16(c->buf, P->patch, rank, n);
+    if (write_dataset(c, g, "patch", H5T_STD_U16LE, H5T_NATIVE_UINT16, n, 1, c->buf)) goto out;
+    gather_u8(c->buf, P->level, rank, n);
+    if (write_dataset(c, g, "level", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 1, c->buf)) goto out;
+    gather_u64(c->buf, P->id, rank, n);
+    if (write_dataset(c, g, "id", H5T_STD_U64LE, H5T_NATIVE_UINT64, n, 1, c->buf)) goto out;
+    for (int e = 0; e < P->nextra; e++) {
+        gather_f64(buf, P->extra[e].v, rank, n);
+        if (write_dataset(c, g, P->extra[e].name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 1, buf))
             goto out;
+    }
     close_id(&g, H5Gclose);
+
+    /* The solver's own order, when it is not the id order: /solver/order[r] is the place in
+     * the solver's arrays of the particle of row r.  The reader puts every particle back in
+     * its place, so a restart continues with the very arrays the run had (its sums in the
+     * same order: bit-identical to the run that was not stopped). */
+    int identity = 1;
+    for (size_t r = 0; r < n && identity; r++) identity = rank[r].index == r;
+    if (!identity) {
+        if ((g = make_group(c, f, "solver")) < 0) goto out;
+        if (n <= UINT32_MAX) {
+            uint32_t *v = c->buf;
+            for (size_t r = 0; r < n; r++) v[r] = (uint32_t)rank[r].index;
+            if (write_dataset(c, g, "order", H5T_STD_U32LE, H5T_NATIVE_UINT32, n, 1, v)) goto out;
+        } else {
+            uint64_t *v = c->buf;
+            for (size_t r = 0; r < n; r++) v[r] = (uint64_t)rank[r].index;
+            if (write_dataset(c, g, "order", H5T_STD_U64LE, H5T_NATIVE_UINT64, n, 1, v)) goto out;
+        }
+        close_id(&g, H5Gclose);
+    }
 
     /* Vertex connectivity 0 .. N-1 for the XDMF Polyvertex topology: ParaView's Xdmf3
      * readers make no cells without it, and points without cells do not show in the Points
@@ -312,57 +385,136 @@ static void check_writable(const lub_particles *P)
     if (P->npatches < 0 || P->npatches > LUB_MAX_PATCHES) lub_bug("npatches %d", P->npatches);
     if (P->nextra < 0 || P->nextra > LUB_MAX_EXTRA) lub_bug("nextra %d", P->nextra);
     if (P->n > P->cap) lub_bug("n %zu > capacity %zu", P->n, P->cap);
+    if (!(P->time >= 0) || !isfinite(P->time)) lub_bug("time %g", P->time);
     /* What the reader rejects is never written: a bad kind, patch or level is a bug; a
-     * non-finite position is a failed run (the caller writes the last good state). */
+     * non-finite value is a failed run (the caller writes the last good state). */
     for (size_t i = 0; i < P->n; i++) {
         if (P->kind[i] > LUB_DUMMY) lub_bug("particle %zu has kind %d", i, P->kind[i]);
         if (P->level[i] >= P->nlevels)
             lub_bug("particle %zu has level %d, nlevels %d", i, P->level[i], P->nlevels);
         if (P->patch[i] >= P->npatches && !(P->kind[i] == LUB_FLUID && P->patch[i] == 0))
             lub_bug("particle %zu has patch %d, npatches %d", i, P->patch[i], P->npatches);
-        for (int d = 0; d < 3; d++)
-            if (!isfinite(P->x[d][i]))
-                lub_fatal_run("particle %zu (id %llu) has a non-finite position; particles at "
-                              "time %g not written",
-                              i, (unsigned long long)P->id[i], P->time);
+        int finite = isfinite(P->p[i]);
+        for (int d = 0; d < 3; d++) finite = finite && isfinite(P->x[d][i]) && isfinite(P->u[d][i]);
+        for (int e = 0; e < P->nextra; e++) finite = finite && isfinite(P->extra[e].v[i]);
+        if (!finite)
+            lub_fatal_run("particle %zu (id %llu) has a non-finite position, velocity, pressure "
+                          "or %s; particles at time %g not written",
+                          i, (unsigned long long)P->id[i], P->nextra ? "extra field" : "field",
+                          P->time);
         if (P->dim == 2 && P->x[2][i] != 0.0)
             lub_bug("particle %zu has z = %g in 2-D", i, P->x[2][i]);
     }
 }
 
-static void write_sidecar(const lub_particles *P, const char *dir);
+static int cmp_rank(const void *a, const void *b)
+{
+    const lub_particles_rank *x = a, *y = b;
+    return (x->id > y->id) - (x->id < y->id);
+}
 
-void lub_particles_write(const lub_particles *P, const char *dir)
+void lub_particles_writer_init(lub_particles_writer *w, size_t cap)
+{
+    w->cap = cap;
+    w->buf = lub_malloc(3 * (cap ? cap : 1) * sizeof *w->buf);
+    w->rank = lub_malloc((cap ? cap : 1) * sizeof *w->rank);
+    w->sync_dir = 1;
+}
+
+void lub_particles_writer_free(lub_particles_writer *w)
+{
+    free(w->buf);
+    free(w->rank);
+    w->buf = NULL;
+    w->rank = NULL;
+    w->cap = 0;
+}
+
+/* Flush the directory holding path: a rename is durable only once its directory is. */
+static int sync_parent(const char *path)
+{
+    char dir[LUB_PATH_MAX];
+    snprintf(dir, sizeof dir, "%s", path);
+    char *slash = strrchr(dir, '/');
+    if (slash == dir)
+        dir[1] = '\0';
+    else if (slash)
+        *slash = '\0';
+    else
+        strcpy(dir, ".");
+    return lub_fsync_dir(dir);
+}
+
+static void write_sidecar(const lub_particles *P, const char *dir, int sync_dir);
+
+void lub_particles_writer_write(lub_particles_writer *w, const lub_particles *P, const char *dir)
 {
     char path[LUB_PATH_MAX], tmp[LUB_PATH_MAX];
     if (snprintf(path, sizeof path, "%s/particles.h5", dir) >= (int)sizeof path ||
         snprintf(tmp, sizeof tmp, "%s/particles.h5.tmp%ld", dir, (long)getpid()) >= (int)sizeof tmp)
         lub_fatal_run("path too long: '%s/particles.h5'", dir);
     check_writable(P);
+    if (P->n > w->cap) lub_bug("%zu particles, the writer has room for %zu", P->n, w->cap);
+    /* id order (see gather3): a sort of (id, index) pairs in the writer's buffer */
+    for (size_t i = 0; i < P->n; i++) {
+        w->rank[i].id = P->id[i];
+        w->rank[i].index = i;
+    }
+    qsort(w->rank, P->n, sizeof *w->rank, cmp_rank);
+    for (size_t r = 1; r < P->n; r++)
+        if (w->rank[r].id == w->rank[r - 1].id)
+            lub_bug("particles %zu and %zu have the same id %llu", w->rank[r - 1].index,
+                    w->rank[r].index, (unsigned long long)w->rank[r].id);
 
     h5ctx c;
-    double *buf = lub_malloc(3 * (P->n ? P->n : 1) * sizeof *buf); /* before HDF5 is used */
     ctx_begin(&c);
-    c.buf = buf;
+    c.buf = w->buf;
     if ((c.fapl = file_access_plist(1)) < 0)
         fail_h5(&c, "cannot make a file access property list");
     else if ((c.file = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, c.fapl)) < 0)
         fail_h5(&c, "cannot create '%s'", tmp);
     else
-        write_contents(&c, P);
+        write_contents(&c, P, w->rank);
     if (!ctx_end(&c)) {
-        /* Flush to disk before the rename makes the file visible. */
+        /* Flush to disk before the rename makes the file visible, and the folder after. */
         int fd = open(tmp, O_RDONLY);
         if (fd < 0 || fsync(fd) != 0) fail(&c, "cannot sync '%s': %s", tmp, strerror(errno));
         if (fd >= 0) close(fd);
         if (!c.failed && rename(tmp, path) != 0)
             fail(&c, "cannot rename '%s': %s", tmp, strerror(errno));
+        if (!c.failed && w->sync_dir && sync_parent(path) != 0)
+            fail(&c, "cannot sync the folder of '%s': %s", path, strerror(errno));
     }
     if (c.failed) {
         unlink(tmp);
         lub_fatal_run("%s: cannot write particle file: %s", path, c.msg);
     }
-    write_sidecar(P, dir);
+    write_sidecar(P, dir, w->sync_dir);
+}
+
+/* Raise a caught fatal error again, with its status. */
+static _Noreturn void fatal_status(int status, const char *fmt, ...)
+    __attribute__((format(printf, 2, 3)));
+static _Noreturn void fatal_status(int status, const char *fmt, ...)
+{
+    va_list ap;
+    va_start(ap, fmt);
+    lub_vfatal_at(status, NULL, 0, 0, fmt, ap);
+}
+
+void lub_particles_write(const lub_particles *P, const char *dir)
+{
+    lub_particles_writer w;
+    lub_particles_writer_init(&w, P->n); /* before HDF5 is used: lub_malloc may be fatal */
+    lub_catcher c;
+    if (lub_error_catch(&c) == 0) {
+        lub_particles_writer_write(&w, P, dir);
+        lub_error_uncatch();
+        lub_particles_writer_free(&w);
+    } else {
+        lub_particles_writer_free(&w);
+        fatal_status(c.status, "%s", c.message);
+    }
 }
 
 /* ------------------------------------------------------------------------------------------ */
@@ -479,6 +631,41 @@ out:
     return rc;
 }
 
+/* 1 if the dataset's storage may hold less than its values (a compression filter). */
+static int compressed(hid_t d)
+{
+    hid_t dcpl = H5Dget_create_plist(d);
+    if (dcpl < 0) return 1;
+    int nf = H5Pget_nfilters(dcpl), packed = 0;
+    for (int k = 0; k < nf; k++) {
+        unsigned flags, conf;
+        size_t nv = 0;
+        H5Z_filter_t id = H5Pget_filter2(dcpl, (unsigned)k, &flags, &nv, NULL, 0, NULL, &conf);
+        if (id != H5Z_FILTER_FLETCHER32 && id != H5Z_FILTER_SHUFFLE) packed = 1;
+    }
+    H5Pclose(dcpl);
+    return packed;
+}
+
+/* The bytes the dataset declares must be in the file: its allocated storage (at least the
+ * values, uncompressed), within the file's size. */
+static int check_storage(h5ctx *c, hid_t d, hid_t t, const char *gname, const char *name,
+                         const hsize_t *dims, int rank)
+{
+    double values = 1;
+    for (int k = 0; k < rank; k++) values *= (double)dims[k];
+    const double need = values * (double)H5Tget_size(t);
+    const double have = (double)H5Dget_storage_size(d);
+    /* deflate packs at most about 1000 to 1 */
+    const double room = compressed(d) ? 1100 * have : have;
+    if (need > room)
+        return fail(c,
+                    "%s/%s declares %.0f values (%.4g bytes) but the file holds %.4g bytes of "
+                    "it: damaged or cut short",
+                    gname, name, values, need, have);
+    return 0;
+}
+
 /* Open dataset <gname>/<name>, check its class and shape (n_expected rows, or any when
  * *n is (size_t)-1 on entry, then set; ncols 1 for rank 1).  Returns the open dataset. */
 static hid_t open_dataset(h5ctx *c, hid_t g, const char *gname, const char *name, int ncols,
@@ -527,6 +714,9 @@ static hid_t open_dataset(h5ctx *c, hid_t g, const char *gname, const char *name
              name, (unsigned long long)dims[0], *n);
         goto bad;
     }
+    /* Sizes against the file before anything is allocated for them: a damaged or forged
+     * header may declare 10^10 rows that the file does not hold. */
+    if (check_storage(c, d, t, gname, name, dims, rank)) goto bad;
     H5T_class_t cls = H5Tget_class(t);
     int ok = (want_float && cls == H5T_FLOAT) || (want_int && cls == H5T_INTEGER);
     if (!ok) {
@@ -555,7 +745,7 @@ static int read_dataset(h5ctx *c, hid_t g, const char *gname, const char *name, 
     if (d < 0) return -1;
     int rc = 0;
     if (n > 0 && H5Dread(d, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)
-        rc = fail_h5(c, "cannot read %s/%s", gname, name);
+        rc = fail_h5(c, "cannot read %s/%s: the file is damaged or unreadable", gname, name);
     H5Dclose(d);
     return rc;
 }
@@ -590,6 +780,8 @@ static int read_header(h5ctx *c, hid_t f, lub_particles *P)
         return -1;
     P->step = (long)step;
     if (step < 0) return fail(c, "attribute 'step' is %lld, expected >= 0", (long long)step);
+    /* a negative time would name the time folders -0.98, ... */
+    if (P->time < 0) return fail(c, "attribute 'time' is %g, expected >= 0", P->time);
     if (P->dim != 2 && P->dim != 3)
         return fail(c, "attribute 'dimension' is %d, expected 2 or 3", P->dim);
     if (P->nlevels < 1 || P->nlevels > LUB_MAX_LEVELS)
@@ -609,6 +801,13 @@ static int read_header(h5ctx *c, hid_t f, lub_particles *P)
                  read_attr_double(c, g, objname, "lambda0", &L->lambda0);
         H5Gclose(g);
         if (rc) return -1;
+        /* lengths and the reference values of T-4, T-5 are positive: a zero l0 divides */
+        const char *names[4] = {"l0", "re", "n0", "lambda0"};
+        const double vals[4] = {L->l0, L->re, L->n0, L->lambda0};
+        for (int a = 0; a < 4; a++)
+            if (!(vals[a] > 0))
+                return fail(c, "attribute '%s' of %s is %g, expected > 0", names[a], objname,
+                            vals[a]);
     }
 
     /* /patches: 1-D strings, fixed or variable length. */
@@ -746,6 +945,67 @@ static int read_int_field(h5ctx *c, hid_t g, const char *name, size_t n, int64_t
     return 0;
 }
 
+static int check_finite(h5ctx *c, const char *name, const double *v, size_t n)
+{
+    for (size_t i = 0; i < n; i++)
+        if (!isfinite(v[i])) return fail(c, "/fields/%s[%zu] is not finite (%g)", name, i, v[i]);
+    return 0;
+}
+
+/* Put every particle back where the solver had it (/solver/order, written when that order
+ * is not the id order of the rows); the rows stay in file order without it.  c->buf (3 n
+ * values) is the scratch space of the moves. */
+static int restore_order(h5ctx *c, lub_particles *P, size_t n)
+{
+    htri_t ex = H5Lexists(c->file, "solver", H5P_DEFAULT);
+    if (ex < 0) return fail_h5(c, "cannot look up /solver");
+    if (ex == 0 || n == 0) return 0;
+    ex = H5Lexists(c->file, "solver/order", H5P_DEFAULT);
+    if (ex <= 0) return fail(c, "group /solver holds no dataset 'order'");
+    hid_t g = H5Gopen2(c->file, "solver", H5P_DEFAULT);
+    if (g < 0) return fail_h5(c, "cannot open group /solver");
+    uint64_t *order = malloc(n * sizeof *order);
+    unsigned char *seen = calloc(n, 1);
+    int rc = -1;
+    if (!order || !seen) {
+        fail(c, "out of memory reading /solver/order of %zu particles", n);
+        goto out;
+    }
+    if (read_dataset(c, g, "/solver", "order", 1, n, 0, 1, H5T_NATIVE_UINT64, order)) goto out;
+    for (size_t r = 0; r < n; r++) {
+        if (order[r] >= n || seen[order[r]]) {
+            fail(c, "/solver/order[%zu] = %llu: not a place of 0 .. %zu, each once", r,
+                 (unsigned long long)order[r], n - 1);
+            goto out;
+        }
+        seen[order[r]] = 1;
+    }
+    double *tmp = c->buf;
+#define LUB_PLACE(arr, type)                                                                       \
+    do {                                                                                           \
+        type *t_ = (type *)(void *)tmp;                                                            \
+        memcpy(t_, (arr), n * sizeof(type));                                                       \
+        for (size_t r = 0; r < n; r++) (arr)[order[r]] = t_[r];                                    \
+    } while (0)
+    for (int d = 0; d < 3; d++) {
+        LUB_PLACE(P->x[d], double);
+        LUB_PLACE(P->u[d], double);
+    }
+    LUB_PLACE(P->p, double);
+    LUB_PLACE(P->kind, uint8_t);
+    LUB_PLACE(P->patch, uint16_t);
+    LUB_PLACE(P->level, uint8_t);
+    LUB_PLACE(P->id, uint64_t);
+    for (int e = 0; e < P->nextra; e++) LUB_PLACE(P->extra[e].v, double);
+#undef LUB_PLACE
+    rc = 0;
+out:
+    free(order);
+    free(seen);
+    H5Gclose(g);
+    return rc;
+}
+
 static int read_contents(h5ctx *c, lub_particles *P)
 {
     hid_t f = c->file;
@@ -786,6 +1046,7 @@ static int read_contents(h5ctx *c, lub_particles *P)
     for (int e = 0; e < nextra; e++) lub_particles_extra(P, extra[e]); /* names checked */
 
     c->buf = malloc(3 * (n ? n : 1) * sizeof(double));
+    c->own_buf = 1;
     if (!c->buf) {
         fail(c, "out of memory reading %zu particles", n);
         goto out;
@@ -809,13 +1070,22 @@ static int read_contents(h5ctx *c, lub_particles *P)
         }
     if (read_dataset(c, g, "/fields", "velocity", 3, n, 1, 0, H5T_NATIVE_DOUBLE, buf)) goto out;
     for (size_t i = 0; i < n; i++)
-        for (int d = 0; d < 3; d++) P->u[d][i] = buf[3 * i + d];
+        for (int d = 0; d < 3; d++) {
+            double v = buf[3 * i + d];
+            if (!isfinite(v)) {
+                fail(c, "/fields/velocity[%zu][%d] is not finite (%g)", i, d, v);
+                goto out;
+            }
+            P->u[d][i] = v;
+        }
     if (read_dataset(c, g, "/fields", "pressure", 1, n, 1, 0, H5T_NATIVE_DOUBLE, P->p) ||
+        check_finite(c, "pressure", P->p, n) ||
         read_dataset(c, g, "/fields", "id", 1, n, 0, 1, H5T_NATIVE_UINT64, P->id))
         goto out;
     for (int e = 0; e < P->nextra; e++)
         if (read_dataset(c, g, "/fields", P->extra[e].name, 1, n, 1, 1, H5T_NATIVE_DOUBLE,
-                         P->extra[e].v))
+                         P->extra[e].v) ||
+            check_finite(c, P->extra[e].name, P->extra[e].v, n))
             goto out;
 
     if (read_int_field(c, g, "kind", n, tmp, 3, "0 (fluid), 1 (wall) or 2 (dummy)")) goto out;
@@ -834,6 +1104,7 @@ static int read_contents(h5ctx *c, lub_particles *P)
         }
         P->patch[i] = (uint16_t)tmp[i];
     }
+    if (restore_order(c, P, n)) goto out;
     rc = 0;
 out:
     close_id(&g, H5Gclose);
@@ -966,13 +1237,22 @@ static void xdmf_attribute(FILE *fp, int indent, const char *prefix, const char 
  * cell; without it (conn_bytes 0, a foreign file) Xdmf3 readers show points but no cells.
  * The id (uint64 in the file) is described as Int 8 because ParaView's Xdmf3 reader has no
  * 64-bit unsigned array type and skips such arrays; HDF5 converts on reading, exact for ids
- * below 2^63. */
-static void xdmf_grid(FILE *fp, int indent, const char *name, double time, const char *prefix,
-                      size_t n, int conn_bytes, int nextra, const char extra[][LUB_NAME_MAX])
+ * below 2^63.
+ *
+ * The position is also a point attribute: a reader of the time series that takes the
+ * geometry of the first time only and the attributes of every time (meshio's
+ * TimeSeriesReader) then still has each time's positions.
+ *
+ * with_time: a <Time> element (the grids of the temporal collection).  The grid of a
+ * folder's own particles.xdmf has none: meshio.read takes a lone grid only with Topology,
+ * Geometry and Attribute in it (its time is the file's `time` attribute). */
+static void xdmf_grid(FILE *fp, int indent, const char *name, int with_time, double time,
+                      const char *prefix, size_t n, int conn_bytes, int nextra,
+                      const char extra[][LUB_NAME_MAX])
 {
     const int in1 = indent + 2, in2 = indent + 4;
     fprintf(fp, "%*s<Grid Name=\"%s\" GridType=\"Uniform\">\n", indent, "", name);
-    fprintf(fp, "%*s<Time Value=\"%.17g\"/>\n", in1, "", time);
+    if (with_time) fprintf(fp, "%*s<Time Value=\"%.17g\"/>\n", in1, "", time);
     fprintf(fp,
             "%*s<Topology TopologyType=\"Polyvertex\" NumberOfElements=\"%zu\" "
             "NodesPerElement=\"1\"%s>\n",
@@ -987,6 +1267,7 @@ static void xdmf_grid(FILE *fp, int indent, const char *name, double time, const
     fprintf(fp, "%*s<Geometry GeometryType=\"XYZ\">\n", in1, "");
     xdmf_item(fp, in2, prefix, "position", n, 3, "Float", 8);
     fprintf(fp, "%*s</Geometry>\n", in1, "");
+    xdmf_attribute(fp, in1, prefix, "position", n, 3, "Float", 8);
     xdmf_attribute(fp, in1, prefix, "velocity", n, 3, "Float", 8);
     xdmf_attribute(fp, in1, prefix, "pressure", n, 1, "Float", 8);
     xdmf_attribute(fp, in1, prefix, "kind", n, 1, "UChar", 1);
@@ -1009,7 +1290,7 @@ static void xdmf_tail(FILE *fp)
     fprintf(fp, "  </Domain>\n</Xdmf>\n");
 }
 
-static void write_sidecar(const lub_particles *P, const char *dir)
+static void write_sidecar(const lub_particles *P, const char *dir, int sync_dir)
 {
     char path[LUB_PATH_MAX];
     char extra[LUB_MAX_EXTRA][LUB_NAME_MAX];
@@ -1019,53 +1300,132 @@ static void write_sidecar(const lub_particles *P, const char *dir)
     lub_atomic_file af;
     FILE *fp = lub_atomic_open(&af, path);
     if (!fp) lub_fatal_run("%s: cannot write: %s", path, strerror(errno));
+    af.sync_dir = sync_dir;
     xdmf_head(fp);
-    xdmf_grid(fp, 4, "particles", P->time, "", P->n, P->n <= UINT32_MAX ? 4 : 8, P->nextra,
+    xdmf_grid(fp, 4, "particles", 0, P->time, "", P->n, P->n <= UINT32_MAX ? 4 : 8, P->nextra,
               (const char(*)[LUB_NAME_MAX])extra);
     xdmf_tail(fp);
     if (lub_atomic_close(&af) != 0) lub_fatal_run("%s: cannot write: %s", path, strerror(errno));
 }
 
-size_t lub_case_xdmf_write(const lub_case *c)
+/* ---- the case's time series ---------------------------------------------------------- */
+
+static int cmp_entry(const void *a, const void *b)
 {
+    double x = ((const lub_xdmf_entry *)a)->time, y = ((const lub_xdmf_entry *)b)->time;
+    return (x > y) - (x < y);
+}
+
+/* Room for one more entry. */
+static lub_xdmf_entry *series_slot(lub_xdmf_series *s)
+{
+    if (s->n == s->cap) {
+        s->cap = s->cap ? 2 * s->cap : 16;
+        s->e = lub_realloc(s->e, s->cap * sizeof *s->e);
+    }
+    return &s->e[s->n];
+}
+
+void lub_xdmf_series_scan(lub_xdmf_series *s, const lub_case *c)
+{
+    memset(s, 0, sizeof *s);
+    s->c = *c;
     lub_time *times = NULL;
-    size_t nt = lub_case_times(c, &times), listed = 0;
-    char path[LUB_PATH_MAX];
-    lub_case_path(c, path, "particles.xdmf");
-    lub_atomic_file af;
-    FILE *fp = NULL;
+    size_t nt = lub_case_times(c, &times);
     for (size_t k = 0; k < nt; k++) {
-        char h5[LUB_PATH_MAX], prefix[80];
+        char h5[LUB_PATH_MAX];
         struct stat st;
         lub_case_pathf(c, h5, "%s/particles.h5", times[k].name);
         if (stat(h5, &st) != 0) continue;
         lub_particles_info info;
         char msg[LUB_PATH_MAX + 1100];
         if (read_info(h5, &info, msg, sizeof msg)) {
-            lub_warning("%s (time %s left out of %s)", msg, times[k].name, path);
+            lub_warning("%s (time %s left out of %s/particles.xdmf)", msg, times[k].name, c->root);
             continue;
         }
-        if (!fp) {
-            if (!(fp = lub_atomic_open(&af, path))) {
-                free(times);
-                lub_fatal_run("%s: cannot write: %s", path, strerror(errno));
-            }
-            xdmf_head(fp);
-            fprintf(fp, "    <Grid Name=\"particles\" GridType=\"Collection\" "
-                        "CollectionType=\"Temporal\">\n");
-        }
-        snprintf(prefix, sizeof prefix, "%s/", times[k].name);
-        xdmf_grid(fp, 6, times[k].name, times[k].value, prefix, info.n, info.conn_bytes,
-                  info.nextra, (const char(*)[LUB_NAME_MAX])info.extra);
-        listed++;
+        lub_xdmf_entry *e = series_slot(s);
+        snprintf(e->name, sizeof e->name, "%s", times[k].name);
+        e->time = info.time;
+        e->n = info.n;
+        e->conn_bytes = info.conn_bytes;
+        e->nextra = info.nextra;
+        memcpy(e->extra, info.extra, sizeof e->extra);
+        s->n++;
     }
     free(times);
-    if (!fp) {
+    if (s->n > 1) qsort(s->e, s->n, sizeof *s->e, cmp_entry); /* (none: s->e is NULL) */
+}
+
+size_t lub_xdmf_series_write(const lub_xdmf_series *s)
+{
+    char path[LUB_PATH_MAX];
+    lub_case_path(&s->c, path, "particles.xdmf");
+    if (s->n == 0) {
         unlink(path); /* no particles any more: an old collection would be stale */
         return 0;
+    }
+    lub_atomic_file af;
+    FILE *fp = lub_atomic_open(&af, path);
+    if (!fp) lub_fatal_run("%s: cannot write: %s", path, strerror(errno));
+    xdmf_head(fp);
+    fprintf(fp, "    <Grid Name=\"particles\" GridType=\"Collection\" "
+                "CollectionType=\"Temporal\">\n");
+    for (size_t k = 0; k < s->n; k++) {
+        const lub_xdmf_entry *e = &s->e[k];
+        char prefix[80];
+        snprintf(prefix, sizeof prefix, "%s/", e->name);
+        xdmf_grid(fp, 6, e->name, 1, e->time, prefix, e->n, e->conn_bytes, e->nextra,
+                  (const char(*)[LUB_NAME_MAX])e->extra);
     }
     fprintf(fp, "    </Grid>\n");
     xdmf_tail(fp);
     if (lub_atomic_close(&af) != 0) lub_fatal_run("%s: cannot write: %s", path, strerror(errno));
-    return listed;
+    return s->n;
+}
+
+void lub_xdmf_series_put(lub_xdmf_series *s, const char *name, const lub_particles *P)
+{
+    lub_xdmf_entry *e = NULL;
+    for (size_t k = 0; k < s->n && !e; k++)
+        if (strcmp(s->e[k].name, name) == 0) e = &s->e[k];
+    if (!e) {
+        e = series_slot(s);
+        s->n++;
+    }
+    memset(e, 0, sizeof *e);
+    snprintf(e->name, sizeof e->name, "%s", name);
+    e->time = P->time;
+    e->n = P->n;
+    e->conn_bytes = P->n <= UINT32_MAX ? 4 : 8;
+    e->nextra = P->nextra;
+    for (int k = 0; k < P->nextra; k++) strcpy(e->extra[k], P->extra[k].name);
+    qsort(s->e, s->n, sizeof *s->e, cmp_entry);
+    lub_xdmf_series_write(s);
+}
+
+void lub_xdmf_series_remove(lub_xdmf_series *s, const char *name)
+{
+    for (size_t k = 0; k < s->n; k++)
+        if (strcmp(s->e[k].name, name) == 0) {
+            memmove(&s->e[k], &s->e[k + 1], (s->n - k - 1) * sizeof *s->e);
+            s->n--;
+            break;
+        }
+    lub_xdmf_series_write(s);
+}
+
+void lub_xdmf_series_free(lub_xdmf_series *s)
+{
+    free(s->e);
+    s->e = NULL;
+    s->n = s->cap = 0;
+}
+
+size_t lub_case_xdmf_write(const lub_case *c)
+{
+    lub_xdmf_series s;
+    lub_xdmf_series_scan(&s, c);
+    size_t n = lub_xdmf_series_write(&s);
+    lub_xdmf_series_free(&s);
+    return n;
 }

@@ -24,6 +24,7 @@
 #define LUB_PARTICLES_PARTICLES_IO_H
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "io/case.h"
 #include "particles/particles.h"
@@ -32,9 +33,33 @@
 
 /* Write <dir>/particles.h5 and its sidecar <dir>/particles.xdmf, each through a temporary
  * name renamed when complete (dir is normally the temporary folder of lub_timedir_begin).
- * Only particles 0 .. P->n-1 are written.  Fatal run error (exit 2) naming the file and the
- * HDF5 reason when writing fails. */
+ * Only particles 0 .. P->n-1 are written, in id order (the rows of every time are then the
+ * same particles wherever the set is the same), every dataset with HDF5's Fletcher32
+ * checksum; the order P holds them in is kept in /solver/order when it is not the id
+ * order, and lub_particles_read restores it.  Fatal run error (exit 2) naming the file and
+ * the HDF5 reason when writing fails.  A non-finite value is a failed run (exit 2). */
 void lub_particles_write(const lub_particles *P, const char *dir);
+
+/* A row of the id order: the particle's id and its index in P. */
+typedef struct {
+    uint64_t id;
+    size_t index;
+} lub_particles_rank;
+
+/* The buffers of lub_particles_write allocated once, for a time loop that writes without
+ * allocating: room for cap particles (more is a bug: reserve the capacity the particles
+ * can reach). */
+typedef struct {
+    size_t cap;
+    double *buf;              /* 3 cap values: one field's rows */
+    lub_particles_rank *rank; /* cap rows: the sort by id */
+    int sync_dir;             /* 1 (init): fsync dir after the renames; 0 when dir is a
+                                 temporary time folder, which lub_timedir_commit syncs */
+} lub_particles_writer;
+void lub_particles_writer_init(lub_particles_writer *w, size_t cap);
+void lub_particles_writer_free(lub_particles_writer *w);
+/* lub_particles_write with w's buffers. */
+void lub_particles_writer_write(lub_particles_writer *w, const lub_particles *P, const char *dir);
 
 /* Read a particle file into P, which must hold no storage (never initialised, or freed);
  * P->cap == P->n afterwards (reserve more before a time loop).  Every check of the format is
@@ -57,10 +82,36 @@ typedef struct {
 /* Fatal input error (exit 1) naming the file when it is not a lubkit particle file. */
 void lub_particles_read_info(const char *path, lub_particles_info *info);
 
-/* Write <case>/particles.xdmf, the temporal collection over every time folder that holds a
- * particles.h5 (a folder whose file cannot be read is skipped with a warning), atomically.
- * Returns the number of times listed; with none, no file is written (and an old one is
- * removed).  Opens every listed file's header: call it after writing a time, not per step. */
+/* <case>/particles.xdmf: the temporal collection over every time folder that holds a
+ * particles.h5, each grid with the exact time of its file.  A solver keeps the index of the
+ * collection (lub_xdmf_series) and rewrites the file from it after every time it writes,
+ * without opening the other folders' files again (that made writing grow with the square of
+ * the number of folders). */
+typedef struct {
+    char name[64]; /* the folder */
+    double time;   /* the file's time attribute [s] */
+    size_t n;
+    int conn_bytes, nextra;
+    char extra[LUB_MAX_EXTRA][LUB_NAME_MAX];
+} lub_xdmf_entry;
+typedef struct {
+    lub_case c;
+    lub_xdmf_entry *e; /* sorted by time */
+    size_t n, cap;
+} lub_xdmf_series;
+/* Index every time folder's particles.h5 (headers only; a folder whose file cannot be read
+ * is left out with a warning).  The file is not written. */
+void lub_xdmf_series_scan(lub_xdmf_series *s, const lub_case *c);
+/* Add (or replace) the folder `name` holding P's particles, and rewrite the file. */
+void lub_xdmf_series_put(lub_xdmf_series *s, const char *name, const lub_particles *P);
+/* Leave the folder `name` out (before deleting it), and rewrite the file. */
+void lub_xdmf_series_remove(lub_xdmf_series *s, const char *name);
+/* Write the file atomically (none, and an old one removed, when the index is empty);
+ * returns the number of times listed. */
+size_t lub_xdmf_series_write(const lub_xdmf_series *s);
+void lub_xdmf_series_free(lub_xdmf_series *s);
+
+/* Scan and write in one: particleGen, and any program that changes time folders once. */
 size_t lub_case_xdmf_write(const lub_case *c);
 
 #endif

@@ -6,20 +6,20 @@
 #include "io/dict.h"
 #include "test.h"
 
-static const char *controlDict = "# run control\n"                /* 1 */
-                                 "application: lubFoam\n"          /* 2 */
-                                 "endTime:     0.03\n"             /* 3 */
-                                 "deltaT:      1.0e-6\n"           /* 4 */
-                                 "nSteps:      100\n"              /* 5 */
-                                 "adjustTimeStep: false\n"         /* 6 */
+static const char *controlDict = "# run control\n"                  /* 1 */
+                                 "application: lubFoam\n"           /* 2 */
+                                 "endTime:     0.03\n"              /* 3 */
+                                 "deltaT:      1.0e-6\n"            /* 4 */
+                                 "nSteps:      100\n"               /* 5 */
+                                 "adjustTimeStep: false\n"          /* 6 */
                                  "gravity:     { g: [0, -9.81] }\n" /* 7 */
-                                 "walls:\n"                        /* 8 */
-                                 "  lowerWall:\n"                  /* 9 */
-                                 "    velocity: [1.2, 0]\n"        /* 10 */
-                                 "  cylinder: { radius: 0.04 }\n"  /* 11 */
-                                 "levels:\n"                       /* 12 */
-                                 "  - { l0: 5e-6 }\n"              /* 13 */
-                                 "  - { l0: 4e-5 }\n";             /* 14 */
+                                 "walls:\n"                         /* 8 */
+                                 "  lowerWall:\n"                   /* 9 */
+                                 "    velocity: [1.2, 0]\n"         /* 10 */
+                                 "  cylinder: { radius: 0.04 }\n"   /* 11 */
+                                 "levels:\n"                        /* 12 */
+                                 "  - { l0: 5e-6 }\n"               /* 13 */
+                                 "  - { l0: 4e-5 }\n";              /* 14 */
 
 static void test_valid(void)
 {
@@ -71,8 +71,8 @@ static void test_choice_and_bool(void)
 static void test_unknown_key(void)
 {
     lub_dict *d = lub_dict_parse("system/schemes.yaml", "laplacian: standard\n"
-                                                         "viscosity: implicit\n"
-                                                         "gradiant: lsmps\n");
+                                                        "viscosity: implicit\n"
+                                                        "gradiant: lsmps\n");
     lub_node *r = lub_dict_root(d);
     lub_dict_str_or(r, "laplacian", "standard");
     lub_dict_str_or(r, "gradient", "lsmps");
@@ -86,7 +86,8 @@ static void test_unknown_key(void)
     lub_node *gr = lub_dict_map(lub_dict_root(d), "gravity");
     double g[3];
     lub_dict_vec(gr, "g", g, 2, 3, LUB_ANY);
-    CHECK_FATAL(lub_dict_finish(d), "m.yaml:3:3: unknown key 'zzzzzz' in 'gravity' (valid keys: g)");
+    CHECK_FATAL(lub_dict_finish(d),
+                "m.yaml:3:3: unknown key 'zzzzzz' in 'gravity' (valid keys: g)");
     lub_dict_free(d);
 
     /* a mapping nobody looked into is not judged; its parent key must be known */
@@ -105,12 +106,16 @@ static void test_wrong_type(void)
     lub_node *r = lub_dict_root(d);
     CHECK_FATAL(lub_dict_real(r, "endTime", LUB_POSITIVE),
                 "system/controlDict.yaml:1:10: 'endTime' expects a real number, found 'abc'");
-    CHECK_FATAL(lub_dict_int(r, "nSteps", 0, 10), "controlDict.yaml:2:9: 'nSteps' expects an integer, found '1.5'");
+    CHECK_FATAL(lub_dict_int(r, "nSteps", 0, 10),
+                "controlDict.yaml:2:9: 'nSteps' expects an integer, found '1.5'");
     double v[3];
-    CHECK_FATAL(lub_dict_vec(r, "g", v, 2, 3, LUB_ANY), "controlDict.yaml:3:4: 'g' expects a list of 2 to 3 numbers");
+    CHECK_FATAL(lub_dict_vec(r, "g", v, 2, 3, LUB_ANY),
+                "controlDict.yaml:3:4: 'g' expects a list of 2 to 3 numbers");
     CHECK_FATAL(lub_dict_map(r, "walls"), "controlDict.yaml:4:8: 'walls' expects a mapping");
-    CHECK_FATAL(lub_dict_bool_or(r, "flag", 0), "controlDict.yaml:5:7: 'flag' expects true or false, found 'maybe'");
-    CHECK_FATAL(lub_dict_str(r, "name"), "controlDict.yaml:6:7: 'name' expects a single value, found a mapping");
+    CHECK_FATAL(lub_dict_bool_or(r, "flag", 0),
+                "controlDict.yaml:5:7: 'flag' expects true or false, found 'maybe'");
+    CHECK_FATAL(lub_dict_str(r, "name"),
+                "controlDict.yaml:6:7: 'name' expects a single value, found a mapping");
     lub_dict_free(d);
 }
 
@@ -122,10 +127,13 @@ static void test_out_of_range(void)
     lub_node *r = lub_dict_root(d);
     CHECK_FATAL(lub_dict_real(r, "deltaT", LUB_POSITIVE),
                 "system/controlDict.yaml:1:9: 'deltaT' must be > 0, found '-1e-6'");
-    CHECK_FATAL(lub_dict_int(r, "nSteps", 0, 10), "controlDict.yaml:2:9: 'nSteps' must be between 0 and 10, found '1000'");
+    CHECK_FATAL(lub_dict_int(r, "nSteps", 0, 10),
+                "controlDict.yaml:2:9: 'nSteps' must be between 0 and 10, found '1000'");
     double v[4];
-    CHECK_FATAL(lub_dict_vec(r, "g", v, 2, 3, LUB_ANY), "controlDict.yaml:3:4: 'g' expects 2 to 3 numbers, found 4");
-    CHECK_FATAL(lub_dict_real(r, "alpha", LUB_UNIT), "controlDict.yaml:4:8: 'alpha' must be >= 0 and <= 1, found '1.5'");
+    CHECK_FATAL(lub_dict_vec(r, "g", v, 2, 3, LUB_ANY),
+                "controlDict.yaml:3:4: 'g' expects 2 to 3 numbers, found 4");
+    CHECK_FATAL(lub_dict_real(r, "alpha", LUB_UNIT),
+                "controlDict.yaml:4:8: 'alpha' must be >= 0 and <= 1, found '1.5'");
     const char *ch[] = {"explicit", "crankNicolson", NULL};
     CHECK_FATAL(lub_dict_choice(r, "scheme", ch, -1),
                 "controlDict.yaml:5:9: 'scheme' must be one of: explicit, crankNicolson; found "
@@ -160,6 +168,57 @@ static void test_malformed(void)
     lub_dict_free(d);
 }
 
+/* What libyaml accepts but a dictionary must not: keys after a second '---' (they would be
+ * ignored), an alias bomb (nested aliases multiplying to 10^9 nodes), a NUL byte (libyaml
+ * reports it by byte offset: the message must give its line, not 1:1). */
+static void test_yaml_limits(void)
+{
+    CHECK_FATAL(lub_dict_parse("system/two.yaml", "a: 1\nb: 2\n---\nc: 3\n"),
+                "system/two.yaml:3:1: a second YAML document begins here");
+    CHECK_FATAL(lub_dict_parse("system/two.yaml", "a: 1\n...\n---\n"), "two.yaml:3:1: a second");
+    /* one document, explicitly started and ended, is fine */
+    lub_dict *d = lub_dict_parse("one.yaml", "---\na: 1\n...\n");
+    CHECK(lub_dict_int(lub_dict_root(d), "a", 0, 9) == 1);
+    lub_dict_free(d);
+
+    const char *bomb = "a: &a [x, x, x, x, x, x, x, x, x]\n"
+                       "b: &b [*a, *a, *a, *a, *a, *a, *a, *a, *a]\n"
+                       "c: &c [*b, *b, *b, *b, *b, *b, *b, *b, *b]\n"
+                       "d: &d [*c, *c, *c, *c, *c, *c, *c, *c, *c]\n"
+                       "e: &e [*d, *d, *d, *d, *d, *d, *d, *d, *d]\n"
+                       "f: &f [*e, *e, *e, *e, *e, *e, *e, *e, *e]\n"
+                       "g: &g [*f, *f, *f, *f, *f, *f, *f, *f, *f]\n"
+                       "h: &h [*g, *g, *g, *g, *g, *g, *g, *g, *g]\n"
+                       "i: &i [*h, *h, *h, *h, *h, *h, *h, *h, *h]\n";
+    CHECK_FATAL(lub_dict_parse("system/bomb.yaml", bomb), "system/bomb.yaml:");
+    CHECK_STR(test_last_error, "aliases (*name) expand to more than 10000 values");
+    /* aliases that repeat a setting are fine */
+    d = lub_dict_parse("alias.yaml", "base: &w { l0: 1e-5 }\nfine: *w\ncoarse: *w\n");
+    CHECK_NEAR(lub_dict_real(lub_dict_map(lub_dict_root(d), "coarse"), "l0", LUB_POSITIVE), 1e-5,
+               0);
+    lub_dict_free(d);
+
+    static const char nul[] = "a: 1\nb: 2\nc: x\0y\n";
+    lub_dict *dn = NULL;
+    char path[] = "/tmp/lubdictnulXXXXXX";
+    int fd = mkstemp(path);
+    CHECK(fd >= 0 && write(fd, nul, sizeof nul - 1) == (ssize_t)(sizeof nul - 1));
+    close(fd);
+    CHECK_FATAL(dn = lub_dict_read(path),
+                ":3:5: unreadable text: control characters are not allowed");
+    CHECK_STR(test_last_error, "(byte 0x00)");
+    (void)dn;
+    unlink(path);
+
+    /* a list of a fixed length asked for with a scalar names the length once */
+    d = lub_dict_parse("m.yaml", "g: down\n");
+    double g[2];
+    CHECK_FATAL(
+        lub_dict_vec(lub_dict_root(d), "g", g, 2, 2, LUB_ANY),
+        "m.yaml:1:4: 'g' expects a list of 2 numbers like [0, 1], found a single value 'down'");
+    lub_dict_free(d);
+}
+
 static void test_files(void)
 {
     char path[] = "/tmp/lubdictXXXXXX";
@@ -174,7 +233,8 @@ static void test_files(void)
     lub_dict_free(d);
     unlink(path);
     CHECK(lub_dict_read_optional("/nonexistent/dir/x.yaml") == NULL);
-    CHECK_FATAL(lub_dict_read("/nonexistent/dir/x.yaml"), "cannot open dictionary '/nonexistent/dir/x.yaml'");
+    CHECK_FATAL(lub_dict_read("/nonexistent/dir/x.yaml"),
+                "cannot open dictionary '/nonexistent/dir/x.yaml'");
 }
 
 /* lub_dict_substitute: the same file under another name parses the given text, messages
@@ -232,6 +292,7 @@ int main(void)
     RUN(test_out_of_range);
     RUN(test_missing_key);
     RUN(test_malformed);
+    RUN(test_yaml_limits);
     RUN(test_files);
     RUN(test_substitute);
     RUN(test_closest);

@@ -436,39 +436,6 @@ static void test_irregular_patch(void)
     free(vd);
 }
 
-/* Time of one evaluation for a uniform patch (printed; the 2-thread figure is machine load
- * dependent, so nothing is asserted beyond a loose bound). */
-static void test_evaluation_cost(void)
-{
-    double b = lub_elastic_hertz_half_width(W_, R_, E_);
-    int sizes[] = {1000, 3000};
-    for (int s = 0; s < 2; s++) {
-        int n = sizes[s];
-        double *x = malloc(n * sizeof *x), *w = malloc(n * sizeof *w);
-        double *p = malloc(n * sizeof *p), *v = malloc(n * sizeof *v);
-        for (int j = 0; j < n; j++) {
-            x[j] = j * 2.5e-6;
-            w[j] = 2.5e-6;
-            p[j] = rnd();
-        }
-        lub_elastic_kernel *k = lub_elastic_kernel_create(n, x, w, n, x, E_, b);
-        struct timespec t0, t1;
-        int reps = s ? 20 : 100;
-        clock_gettime(CLOCK_MONOTONIC, &t0);
-        for (int r = 0; r < reps; r++) lub_elastic_displacement(k, p, v);
-        clock_gettime(CLOCK_MONOTONIC, &t1);
-        double dt = (t1.tv_sec - t0.tv_sec + 1e-9 * (t1.tv_nsec - t0.tv_nsec)) / reps;
-        printf("  N = %d: %.3f ms per evaluation (%.2f ns per pair)\n", n, 1e3 * dt,
-               1e9 * dt / ((double)n * n));
-        CHECK(dt < 1.0);
-        lub_elastic_kernel_free(k);
-        free(x);
-        free(w);
-        free(p);
-        free(v);
-    }
-}
-
 /* ---- the reader ----------------------------------------------------------------------------- */
 
 static char geo_path[256];
@@ -629,7 +596,6 @@ int main(void)
     RUN(test_toeplitz_equals_direct);
     RUN(test_mixed_widths);
     RUN(test_irregular_patch);
-    RUN(test_evaluation_cost);
     RUN(test_reader);
     RUN(test_load_balance);
     return test_summary();

@@ -100,6 +100,8 @@ static void wall_pressure_not_continued(const fo *o, const lubfoam_run *r, const
                 o->name, r->t, dir, r->t, o->t0);
 }
 
+static int wall_pressure_resume_state(fo *o, lubfoam_run *r);
+
 /* A run that starts inside the averaging window of o (at its first step included) continues
  * the average of the earlier run it restarts from: the p.dat of the latest earlier start time
  * whose last sample is the start step (see the header).  Returns 1 if it did. */
@@ -107,6 +109,10 @@ static int wall_pressure_resume(fo *o, lubfoam_run *r)
 {
     double eps = 0.5 * r->dt + 1e-12 * fabs(r->t);
     if (!(r->t >= o->t0 - eps) || !(r->t <= o->t1 + eps) || !(o->t0 < o->t1)) return 0;
+    /* the state kept in the start folder; the tables under postProcessing/ for a folder
+     * written before that was kept */
+    const int kept = wall_pressure_resume_state(o, r);
+    if (kept >= 0) return kept;
     /* at the window's first step, an earlier run held one sample at most (the start step's,
      * which the caller takes again from the start state): nothing to warn about */
     const int at_first = r->t <= o->t0 + eps;
@@ -178,6 +184,89 @@ static int wall_pressure_resume(fo *o, lubfoam_run *r)
     return 1;
 }
 
+/* The running state of a wallPressure in a time folder: uniform/functionObjects/<name>.dat,
+ *     # bin sum[Pa] n
+ *     # wallPressure <name>: samples S steps from t = A to t = B; from F bin W bins N
+ * then one row per bin that holds samples: its index, the sum of the samples (17 digits:
+ * read back exactly) and their number.  Written with every time folder, so that a restart
+ * from any written time continues the average, bit for bit as the run that was not
+ * stopped. */
+static void wall_pressure_state_path(const fo *o, const char *dir, char *path)
+{
+    if (snprintf(path, LUB_PATH_MAX, "%s/uniform/functionObjects/%s.dat", dir, o->name) >=
+        LUB_PATH_MAX)
+        lub_fatal_run("path too long: '%s/uniform/functionObjects/%s.dat'", dir, o->name);
+}
+
+/* From the start folder's state: 1 continued, 0 nothing to continue (no sample yet, or bins
+ * or window changed: said so), -1 no state there (a folder written before it was kept). */
+static int wall_pressure_resume_state(fo *o, lubfoam_run *r)
+{
+    char dir[LUB_PATH_MAX], path[LUB_PATH_MAX];
+    lub_case_path(&r->cs, dir, r->start_name);
+    wall_pressure_state_path(o, dir, path);
+    FILE *fp = fopen(path, "r");
+    if (!fp) return -1;
+    char line[512];
+    long S = -1;
+    double A = 0, B = 0, from = 0, bin = 0;
+    int nbins = 0;
+    while (fgets(line, sizeof line, fp) && line[0] == '#')
+        if (sscanf(line,
+                   "# wallPressure %*s samples %ld steps from t = %lg to t = %lg; from %lg bin "
+                   "%lg bins %d",
+                   &S, &A, &B, &from, &bin, &nbins) == 6)
+            break;
+    if (S < 0) {
+        fclose(fp);
+        lub_fatal("%s: not the state of a wallPressure function object (its second line is "
+                  "'# wallPressure NAME: samples S steps from t = A to t = B; from F bin W bins "
+                  "N')",
+                  path);
+    }
+    if (S == 0) {
+        fclose(fp);
+        return 0;
+    }
+    const double eps = 0.5 * r->dt + 1e-12 * fabs(r->t);
+    if (nbins != o->nbins || from != o->from || bin != o->bin) {
+        fclose(fp);
+        lub_warning("function '%s': the bins changed since the run that wrote %s (from %g, bin "
+                    "%g): its average is not continued; the wall pressure is averaged from t = "
+                    "%g on",
+                    o->name, path, from, bin, r->t);
+        return 0;
+    }
+    if (A < o->t0 - eps) {
+        fclose(fp);
+        lub_warning("function '%s': the average of %s began at t = %g, before timeStart %g "
+                    "(changed since that run?): not continued; the wall pressure is averaged "
+                    "from t = %g on",
+                    o->name, path, A, o->t0, r->t);
+        return 0;
+    }
+    long ib, n;
+    double sum;
+    int lineno = 2;
+    while (fgets(line, sizeof line, fp)) {
+        lineno++;
+        if (line[0] == '#') continue;
+        if (sscanf(line, "%ld %lg %ld", &ib, &sum, &n) != 3 || ib < 0 || ib >= o->nbins || n < 0) {
+            fclose(fp);
+            lub_fatal_at(path, lineno, 1, "expected 'bin sum n' with a bin below %d", o->nbins);
+        }
+        o->sum[ib] = sum;
+        o->count[ib] = n;
+    }
+    fclose(fp);
+    o->samples = S;
+    o->tfirst = A;
+    o->tlast = B;
+    lub_message("function '%s': continues the average of %s (%ld steps from t = %g)", o->name, path,
+                S, A);
+    return 1;
+}
+
 static void wall_pressure(fo *o, lubfoam_run *r);
 
 lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
@@ -220,9 +309,15 @@ lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
                                "function '%s': timeEnd (%g) is earlier than timeStart (%g): the "
                                "window would hold no step",
                                name, o->t1, o->t0);
-            o->nbins = (int)ceil((o->to - o->from) / o->bin - 1e-9);
-            if (o->nbins < 1 || o->nbins > 10000000)
-                lub_node_error(d, "function '%s': %d bins", name, o->nbins);
+            /* counted in double: a tiny bin made more bins than an int holds (the cast was
+             * undefined behaviour, and the message said -2147483648 bins) */
+            const double nb = ceil((o->to - o->from) / o->bin - 1e-9);
+            if (!(nb >= 1 && nb <= 10000000))
+                lub_node_error(lub_dict_find(d, "bin") ? lub_dict_find(d, "bin") : d,
+                               "function '%s': bin %g makes %.4g bins over [%g, %g]: at most "
+                               "10^7 bins (a bin of at least %.4g)",
+                               name, o->bin, nb, o->from, o->to, (o->to - o->from) / 1e7);
+            o->nbins = (int)nb;
             o->sum = lub_calloc((size_t)o->nbins, sizeof *o->sum);
             o->count = lub_calloc((size_t)o->nbins, sizeof *o->count);
         }
@@ -245,12 +340,16 @@ void lubfoam_functions_start(lubfoam_functions *F, lubfoam_run *r)
                                        "momentumZ[kg/s] kineticEnergy[J/m] fluidParticles"
                                      : "t[s] mass[kg] momentumX[kg*m/s] momentumY[kg*m/s] "
                                        "momentumZ[kg*m/s] kineticEnergy[J] fluidParticles");
+            /* on disk at once: a run killed before the first row leaves a table with its
+             * header, not an empty file */
+            fflush(o->fp);
         } else if (o->type == FO_WALLLOAD) {
             char path[LUB_PATH_MAX];
             lub_postproc_path(&r->cs, o->name, r->start_name, "load.dat", path);
             o->fp = fopen(path, "w");
             if (!o->fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
             lub_table_write_header(o->fp, "t[s] load[N/m] particles");
+            fflush(o->fp);
         } else if (!wall_pressure_resume(o, r) && r->step > 0 && r->step % o->interval == 0) {
             /* a restart that continues no earlier average samples its start state, as the
              * run that wrote it did after that step (wall_pressure keeps to the window) */
@@ -384,6 +483,32 @@ void lubfoam_functions_write(lubfoam_functions *F, lubfoam_run *r)
                              (double)o->count[b]};
             lub_table_write_row(fp, row, 3);
         }
+        if (lub_atomic_close(&af) != 0)
+            lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+    }
+}
+
+void lubfoam_functions_write_state(lubfoam_functions *F, const lubfoam_run *r, const char *dir)
+{
+    (void)r;
+    for (int k = 0; k < F->n; k++) {
+        fo *o = &F->f[k];
+        if (o->type != FO_WALLPRESSURE) continue;
+        char sub[LUB_PATH_MAX + 32], path[LUB_PATH_MAX];
+        snprintf(sub, sizeof sub, "%s/uniform/functionObjects", dir);
+        if (lub_mkdir_p(sub) != 0) lub_fatal_run("cannot create '%s': %s", sub, strerror(errno));
+        wall_pressure_state_path(o, dir, path);
+        lub_atomic_file af;
+        FILE *fp = lub_atomic_open(&af, path);
+        if (!fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+        af.sync_dir = 0; /* in the temporary time folder, synced when renamed into place */
+        lub_table_write_header(fp, "bin sum[Pa] n");
+        fprintf(fp,
+                "# wallPressure %s: samples %ld steps from t = %.17g to t = %.17g; from %.17g "
+                "bin %.17g bins %d\n",
+                o->name, o->samples, o->tfirst, o->tlast, o->from, o->bin, o->nbins);
+        for (int b = 0; b < o->nbins; b++)
+            if (o->count[b]) fprintf(fp, "%d %.17g %ld\n", b, o->sum[b], o->count[b]);
         if (lub_atomic_close(&af) != 0)
             lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
     }

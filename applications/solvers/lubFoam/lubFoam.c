@@ -20,26 +20,59 @@
 #include "io/table.h"
 #include "lubFoam.h"
 
-static volatile sig_atomic_t stop_signal = 0;
+static volatile sig_atomic_t stop_signal = 0, write_signal = 0;
 static void on_signal(int sig)
 {
-    stop_signal = sig;
+    if (sig == SIGUSR1)
+        write_signal = sig;
+    else
+        stop_signal = sig;
 }
 
-/* SIGINT and SIGTERM ask for the current state to be written and the run to stop.  The
- * handler stays installed (sigaction without SA_RESETHAND): with -std=c11 glibc's signal()
- * has System V semantics, so a second signal before the state was written (lubSweep signals
- * the run's process group as well as its own children; a second Ctrl-C) used to kill the run
- * and lose the state.  SA_RESTART: system calls of the writers are resumed, not failed. */
-static void install_stop_handlers(void)
+/* As OpenFOAM's solvers: SIGINT, SIGTERM, SIGHUP (the terminal closed) and SIGQUIT ask for
+ * the current state to be written and the run to stop; SIGUSR1 asks for a time folder now,
+ * and the run goes on.  Installed first thing in main, so that a signal in the first
+ * milliseconds (while the dictionaries are read) does not kill the run: it stops before
+ * its first step, having written nothing.  The handler stays installed (sigaction without
+ * SA_RESETHAND): with -std=c11 glibc's signal() has System V semantics, so a second signal
+ * before the state was written (lubSweep signals the run's process group as well as its
+ * own children; a second Ctrl-C) used to kill the run and lose the state.  SA_RESTART:
+ * system calls of the writers are resumed, not failed. */
+static void install_signal_handlers(void)
 {
     struct sigaction sa;
     memset(&sa, 0, sizeof sa);
     sa.sa_handler = on_signal;
     sigemptyset(&sa.sa_mask);
     sa.sa_flags = SA_RESTART;
-    sigaction(SIGINT, &sa, NULL);
-    sigaction(SIGTERM, &sa, NULL);
+    const int sigs[] = {SIGINT, SIGTERM, SIGHUP, SIGQUIT, SIGUSR1};
+    sigset_t set;
+    sigemptyset(&set);
+    for (size_t k = 0; k < sizeof sigs / sizeof *sigs; k++) {
+        sigaction(sigs[k], &sa, NULL);
+        sigaddset(&set, sigs[k]);
+    }
+    /* a parent that blocked them (a shell's trap, a job script) would hide them from the run
+     * for ever: unblocked, a signal already pending is taken now, at the start */
+    sigprocmask(SIG_UNBLOCK, &set, NULL);
+}
+
+static const char *signal_name(int sig)
+{
+    switch (sig) {
+    case SIGINT:
+        return "SIGINT";
+    case SIGTERM:
+        return "SIGTERM";
+    case SIGHUP:
+        return "SIGHUP";
+    case SIGQUIT:
+        return "SIGQUIT";
+    case SIGUSR1:
+        return "SIGUSR1";
+    default:
+        return "signal";
+    }
 }
 
 static void format_hms(double s, char *buf, size_t size)
@@ -114,6 +147,51 @@ static void check_limits(lubfoam_run *r)
         lub_warning("restart at step %ld: the fastest particle (%g m/s) has Courant number %.4g, "
                     "above maxCourant %g (the walls: %.4g); continuing as the run did",
                     r->step, ufluid, co, r->ctl.max_courant, uwall * r->dt / m->l0);
+    /* Gravity: a particle at rest reaches |g| deltaT in one step, and so moves |g| deltaT^2;
+     * the Courant limit holds for that speed too (deltaT: 1e300 took a first step to an
+     * infinite position).  With adjustTimeStep deltaT is the step whenever the particles are
+     * slow, so it is checked as well. */
+    /* the uniform body acceleration the scene's models give (gravity: models/model.h forces) */
+    double acc[3] = {0, 0, 0};
+    int body = 0;
+    for (int k = 0; k < r->scene.nmodels; k++) {
+        lub_model *md = &r->scene.model[k];
+        if (md->type->forces) body |= md->type->forces(md, m, r->dt, acc);
+    }
+    if (body) {
+        double g = 0;
+        for (int d = 0; d < m->dim; d++) g += acc[d] * acc[d];
+        g = sqrt(g);
+        const double dtmax = fmax(r->dt, r->ctl.delta_t);
+        const double cog = fac * g * dtmax * dtmax / m->l0;
+        /* Fatal only when a particle at rest would fall more than l0 in one step: a
+         * viscous film holds its particles far below |g| deltaT (the Poiseuille channel of
+         * tutorials/convergence: |g| deltaT = 4.5 m/s at the first step, 1 m/s in the steady
+         * flow, whose diffusion length sqrt(nu deltaT) spans the channel in one step), so
+         * above maxCourant but below that it warns, as does a restart */
+        if (g > 0 && cog > r->ctl.max_courant * (1 + 1e-9) && cog <= 1)
+            lub_warning("gravity gives a particle at rest |g| deltaT = %g m/s in one step: "
+                        "Courant number %.4g, above maxCourant %g (a free particle would "
+                        "outrun the limit; viscosity holds a film's particles back)",
+                        g * dtmax, cog, r->ctl.max_courant);
+        else if (g > 0 && !(cog <= r->ctl.max_courant * (1 + 1e-9)))
+            lub_fatal("gravity: a particle at rest reaches |g| deltaT = %g m/s in one step of "
+                      "deltaT %g s: Courant number %.4g exceeds maxCourant %g in "
+                      "system/controlDict.yaml: reduce deltaT to at most %.4g s",
+                      g * dtmax, dtmax, cog, r->ctl.max_courant,
+                      sqrt(r->ctl.max_courant * m->l0 / (fac * g)));
+    }
+    /* Implicit viscosity is stable at any nu dt / l0^2, but its matrix I + D L (T-13, D the
+     * diffusion number) has a condition number of about D times the Laplacian's, and the
+     * solve loses the velocity to round-off once that times the machine epsilon 2.2e-16
+     * reaches the tolerance of the solve (nu: 1e300 broke the solver at step 2). */
+    const double dn_implicit_max = 1e6;
+    if (m->c.viscosity != LUB_VISCOSITY_NONE && m->c.viscosity != LUB_VISCOSITY_EXPLICIT &&
+        !(dn <= dn_implicit_max))
+        lub_fatal("diffusion number %.4g (nu %g m^2/s x deltaT %g s / l0^2) is beyond %g, where "
+                  "the implicit viscous solve loses the velocity to round-off: reduce deltaT to "
+                  "at most %.4g s or check nu in constant/transportProperties.yaml",
+                  dn, m->c.nu, r->dt, dn_implicit_max, dn_implicit_max * m->l0 * m->l0 / m->c.nu);
     if (m->c.viscosity == LUB_VISCOSITY_EXPLICIT && dn > r->ctl.max_diffusion)
         lub_fatal("diffusion number %.4g (nu %g m^2/s x deltaT %g s / l0^2) exceeds maxDiffusion "
                   "%g with explicit viscosity: use 'viscosity: { scheme: crankNicolson }' in "
@@ -241,6 +319,7 @@ static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, 
 
 int main(int argc, char **argv)
 {
+    install_signal_handlers();
     /* A log file (runApplication, `> log`) is followed with tail -f: one line at a time. */
     if (!isatty(STDOUT_FILENO)) setvbuf(stdout, NULL, _IOLBF, 0);
     lub_program_info info = {
@@ -253,8 +332,13 @@ int main(int argc, char **argv)
             "  shortened, the log says where the run ends) or nSteps, writes time folders\n"
             "  and the tables of the function objects, and reports its cost in\n"
             "  postProcessing/cost/<startTime>/cost.dat (a case already at its endTime:\n"
-            "  nothing to run, nothing written).  SIGINT/SIGTERM write the\n"
-            "  current state and exit 0.  A non-finite value, a particle leaving the\n"
+            "  nothing to run, nothing written).  SIGINT, SIGTERM, SIGHUP and SIGQUIT\n"
+            "  write the current state and exit 0 (before the first step: nothing\n"
+            "  written); SIGUSR1 writes a time folder at the next step and the run goes\n"
+            "  on.  Write times are multiples of writeInterval from the start of the\n"
+            "  case's first run, whatever the restarts between.  Temporary files and\n"
+            "  folders of a run killed while writing (kill -9, a full disk) are removed at\n"
+            "  the next start.  A non-finite value, a particle leaving the\n"
             "  domain or a fluid particle going through a wall stops the run with exit 2,\n"
             "  naming the particle (and the wall) and the step; the newest time folder is\n"
             "  then the last good state.\n"
@@ -291,13 +375,12 @@ int main(int argc, char **argv)
     memset(&r, 0, sizeof r);
     char path[LUB_PATH_MAX];
     lub_case_open(&r.cs, a.case_dir);
+    lub_case_clean(&r.cs);
     lub_control_read(&r.ctl, lub_case_path(&r.cs, path, "system/controlDict.yaml"));
     lub_geometry geo;
     lub_geometry_read(&geo, lub_case_path(&r.cs, path, "system/particleGenDict.yaml"));
     lubfoam_read_start(&r);
-    if (r.P.dim != geo.dim)
-        lub_fatal("the particles are %d-D but system/particleGenDict.yaml says dimension %d",
-                  r.P.dim, geo.dim);
+    lubfoam_check_particles(&r, &geo);
     /* the fluid and the models the scene lists, and the solvers they need */
     lub_mps_config cfg;
     lub_scene_read(&r.scene, &r.cs, &r.P, &geo, &cfg);
@@ -322,8 +405,13 @@ int main(int argc, char **argv)
         lub_message("lubFoam: the start time %s is at or past endTime %g: nothing to run, "
                     "nothing written (raise endTime in system/controlDict.yaml to continue)",
                     r.start_name, r.ctl.end_time);
+    else if (stop_signal)
+        lub_message("%s during start-up: stopping before the first step, nothing written",
+                    signal_name(stop_signal));
     else if (!dry_run)
         lubfoam_functions_start(fos, &r);
+    const int run_loop = !nothing_to_run && !stop_signal && !dry_run;
+    if (run_loop) lubfoam_output_init(&r);
 
     /* The last step is never shortened to land on endTime (as OpenFOAM with a fixed deltaT):
      * the pressure of a step scales as 1/dt^2 through the source of T-9, so a short last
@@ -349,17 +437,15 @@ int main(int argc, char **argv)
         return LUB_EXIT_OK;
     }
 
-    install_stop_handlers();
     const int tty = isatty(STDOUT_FILENO);
     const double wall0 = lub_wtime();
-    const long step0 = r.step;
     long steps = 0, last_write_step = -1;
     double pit_sum = 0, vit_sum = 0, last_bar = 0;
     int warned_courant = 0, warned_isolated = 0, status = LUB_EXIT_OK;
 
     /* resolution levels with sub-stepping: one pass of the loop is one step of the coarsest
      * level, nr steps of deltaT (dt below) on the finest level (nr: the product of the Nr) */
-    while (!lub_control_finished(&r.ctl, r.t, steps, r.dt)) {
+    while (run_loop && !lub_control_finished(&r.ctl, r.t, steps, r.dt)) {
         double dtc;
         if (r.ctl.adjust_time_step && lub_scene_dt_limit(&r.scene, r.ctl.max_courant, &dtc))
             r.dt = dtc < r.ctl.delta_t ? dtc : r.ctl.delta_t;
@@ -372,7 +458,7 @@ int main(int argc, char **argv)
             if (tty) fputc('\n', stdout);
             if (steps > 0 && r.step != last_write_step) {
                 lub_timer_start(run_timers(&r), LUB_T_OUTPUT);
-                lubfoam_write(&r);
+                lubfoam_write(&r, fos);
                 lubfoam_functions_write(fos, &r);
                 lub_timer_stop(run_timers(&r), LUB_T_OUTPUT);
             }
@@ -420,11 +506,12 @@ int main(int argc, char **argv)
         int finished = lub_control_finished(&r.ctl, r.t, steps, r.dt);
         int due = 0; /* sub-stepping: a write due at any of the pass's fine steps */
         for (int j = 0; j < nr && !due; j++)
-            due = lub_control_write_due(&r.ctl, r.start_time, r.t - j * r.dt, step0, r.step - j,
-                                        r.dt);
-        if (due || finished || stop_signal) {
+            due = lub_control_write_due(&r.ctl, r.write_origin, r.t - j * r.dt, r.write_origin_step,
+                                        r.step - j, r.dt);
+        const int write_now = write_signal;
+        if (due || finished || stop_signal || write_now) {
             lub_timer_start(run_timers(&r), LUB_T_OUTPUT);
-            lubfoam_write(&r);
+            lubfoam_write(&r, fos);
             lubfoam_functions_write(fos, &r);
             last_write_step = r.step;
             lub_scene_rebuild_lists(&r.scene); /* exact restart from this folder */
@@ -437,19 +524,26 @@ int main(int argc, char **argv)
             progress_bar(&r, steps, wall0);
             last_bar = lub_wtime();
         }
+        if (write_now) {
+            write_signal = 0;
+            lub_message("Signal %d (%s): state written at t = %.9g, continuing", write_now,
+                        signal_name(write_now), r.t);
+        }
         if (stop_signal) {
-            lub_message("Signal %d: state written at t = %.9g, stopping", (int)stop_signal, r.t);
+            lub_message("Signal %d (%s): state written at t = %.9g, stopping", (int)stop_signal,
+                        signal_name(stop_signal), r.t);
             break;
         }
     }
-    if (tty && !nothing_to_run) fputc('\n', stdout);
+    if (tty && run_loop) fputc('\n', stdout);
     if (status == LUB_EXIT_OK && !stop_signal && r.ctl.adjust_time_step &&
         r.ctl.stop_at == LUB_STOP_ENDTIME && r.t > r.ctl.end_time + 1e-3 * r.dt)
         lub_message("lubFoam: the last step ended at t = %.9g, %.3g s after endTime %g (a step "
                     "is never shortened to land on endTime)",
                     r.t, r.t - r.ctl.end_time, r.ctl.end_time);
-    if (!nothing_to_run) write_cost(&r, steps, lub_wtime() - wall0, pit_sum, vit_sum);
-    if (!nothing_to_run) lub_scene_summary(&r.scene, r.t);
+    if (run_loop) write_cost(&r, steps, lub_wtime() - wall0, pit_sum, vit_sum);
+    if (run_loop) lub_scene_summary(&r.scene, r.t);
+    if (run_loop) lubfoam_output_free(&r);
     run_free(&r, fos);
     if (status == LUB_EXIT_OK) lub_message("End");
     return status;

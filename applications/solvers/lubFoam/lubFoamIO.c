@@ -110,8 +110,15 @@ void lubfoam_read_start(lubfoam_run *r)
         double dt = lub_dict_real_or(root, "deltaT", c->delta_t, LUB_POSITIVE);
         lub_models_declare_state(root); /* the models read their own entries */
         if (c->adjust_time_step) r->dt = dt < c->delta_t ? dt : c->delta_t;
+        /* the write grid of the case's first run (absent: a state written before it was
+         * kept, taken as starting here) */
+        r->write_origin = lub_dict_real_or(root, "writeOrigin", r->t, LUB_NONNEGATIVE);
+        r->write_origin_step = lub_dict_int_or(root, "writeOriginStep", r->step, 0, 1L << 62);
         lub_dict_finish(st);
         lub_dict_free(st);
+    } else {
+        r->write_origin = r->t;
+        r->write_origin_step = r->step;
     }
     r->start_time = r->t;
 }
@@ -122,27 +129,49 @@ static void write_state(const lubfoam_run *r, const char *dir)
     snprintf(udir, sizeof udir, "%s/uniform", dir);
     if (lub_mkdir_p(udir) != 0) lub_fatal_run("cannot create '%s': %s", udir, strerror(errno));
     snprintf(path, sizeof path, "%s/state.yaml", udir);
-    FILE *fp = fopen(path, "w");
+    /* flushed to disk (fsync) before the folder is renamed into place */
+    lub_atomic_file af;
+    FILE *fp = lub_atomic_open(&af, path);
     if (!fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+    af.sync_dir = 0; /* the folder is synced when it is renamed into place */
     fprintf(fp, "# written by lubFoam: what an exact restart needs\n");
     fprintf(fp, "time:   %.17g\n", r->t);
     fprintf(fp, "step:   %ld\n", r->step);
     fprintf(fp, "deltaT: %.17g\n", r->dt);
+    fprintf(fp, "writeOrigin:     %.17g   # the write grid: writeOrigin + k writeInterval\n",
+            r->write_origin);
+    fprintf(fp, "writeOriginStep: %ld   # (writeControl: timeStep: steps from this one)\n",
+            r->write_origin_step);
     lub_scene_write_state(&r->scene, fp);
-    if (fclose(fp) != 0) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+    if (lub_atomic_close(&af) != 0) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
 }
 
-void lubfoam_write(lubfoam_run *r)
+void lubfoam_output_init(lubfoam_run *r)
+{
+    lub_case_clean(&r->cs);
+    lub_particles_writer_init(&r->writer, r->P.cap);
+    r->writer.sync_dir = 0; /* into temporary time folders, synced by lub_timedir_commit */
+    lub_xdmf_series_scan(&r->series, &r->cs);
+}
+
+void lubfoam_output_free(lubfoam_run *r)
+{
+    lub_particles_writer_free(&r->writer);
+    lub_xdmf_series_free(&r->series);
+}
+
+void lubfoam_write(lubfoam_run *r, lubfoam_functions *fos)
 {
     char name[64], dir[LUB_PATH_MAX];
     lub_time_name(r->t, r->ctl.time_precision, name, sizeof name);
     r->P.time = r->t;
     r->P.step = r->step;
     lub_timedir_begin(&r->cs, name, dir);
-    lub_particles_write(&r->P, dir);
+    lub_particles_writer_write(&r->writer, &r->P, dir);
     write_state(r, dir);
+    lubfoam_functions_write_state(fos, r, dir);
     lub_timedir_commit(&r->cs, name, dir);
-    lub_case_xdmf_write(&r->cs);
+    lub_xdmf_series_put(&r->series, name, &r->P);
 
     if (r->nwritten == r->capwritten) {
         r->capwritten = r->capwritten ? 2 * r->capwritten : 16;
@@ -150,10 +179,12 @@ void lubfoam_write(lubfoam_run *r)
     }
     snprintf(r->written[r->nwritten++], 64, "%s", name);
     if (r->ctl.purge_write > 0 && r->nwritten > (size_t)r->ctl.purge_write) {
+        /* out of particles.xdmf first: a run stopped in between leaves an unlisted folder,
+         * never a listed one that is gone */
         char old[LUB_PATH_MAX];
+        lub_xdmf_series_remove(&r->series, r->written[0]);
         lub_rm_rf(lub_case_path(&r->cs, old, r->written[0]));
         memmove(r->written, r->written + 1, (r->nwritten - 1) * sizeof *r->written);
         r->nwritten--;
-        lub_case_xdmf_write(&r->cs);
     }
 }
