@@ -35,8 +35,11 @@ ifeq ($(SANITIZE),address)
 endif
 
 # Dependencies: pkg-config where the Debian package ships a .pc file (libyaml, HDF5);
-# SuiteSparse 5 (Debian 12) ships none, so CHOLMOD is found by its header folder.
-PKGS          := yaml-0.1 hdf5
+# SuiteSparse 5 (Debian 12) ships none, so CHOLMOD is found by its header folder.  The serial
+# HDF5 by its own name: Debian's `hdf5` is an alternative that points to the MPI build once
+# libhdf5-openmpi-dev is installed (a parallel build selects it explicitly).
+HDF5_PC       := $(if $(shell pkg-config --exists hdf5-serial 2>/dev/null && echo y),hdf5-serial,hdf5)
+PKGS          := yaml-0.1 $(HDF5_PC)
 PKG_CFLAGS    := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS      := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 CHOLMOD_INC   ?= $(firstword $(wildcard /usr/include/suitesparse /usr/local/include/suitesparse))
