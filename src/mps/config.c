@@ -8,7 +8,8 @@
  *     negativePressure: clip         # clip | keep | cavitation
  *     dummyVelocity:    mirror       # mirror (no-slip ghost 2 U - u_i) | wall (U)
  *     pressure:         { alpha: 0, gamma: 0.2, predictor: 0.1 }   # T-9; lub_mps_step
- *     freeSurface:      { beta: 0.97, asymmetry: 0.2, test: sector, sectorAngle: 60 }
+ *     freeSurface:      { beta: 0.97, asymmetry: 0.2, test: sector, sectorAngle: 60,
+ *                         exposedAngle: 150 }
  *                       # T-12 + geometric tests (test: sector | centroid | pnd)
  *     neighbourSkin:    0.2
  *     lsmpsDetMin:      1.0e-2
@@ -49,7 +50,8 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->beta = 0.97;
     c->surface_test = LUB_SURFACE_SECTOR;
     c->asymmetry = 0.2;
-    c->cone_cos = cos(M_PI / 6); /* sectorAngle 60 degrees */
+    c->cone_cos = cos(M_PI / 6);             /* sectorAngle 60 degrees */
+    c->exposed_cos = cos(75.0 * M_PI / 180); /* exposedAngle 150 degrees */
     c->skin = 0.0;
     c->lsmps_det_min = LUB_MPS_LSMPS_DET_MIN;
     c->reorder_interval = 1;
@@ -111,14 +113,28 @@ static void read_schemes(lub_mps_config *c, const char *path)
     else if (lub_dict_find(fs, "asymmetry"))
         lub_node_error(lub_dict_find(fs, "asymmetry"),
                        "freeSurface: 'asymmetry' has no use with test: pnd");
-    if (c->surface_test == LUB_SURFACE_SECTOR)
-        c->cone_cos =
-            cos(0.5 * lub_dict_real_or(fs, "sectorAngle", 60.0, LUB_BETWEEN(10.0, 179.0)) * M_PI /
-                180.0);
-    else if (lub_dict_find(fs, "sectorAngle"))
-        lub_node_error(lub_dict_find(fs, "sectorAngle"),
-                       "freeSurface: 'sectorAngle' belongs to test: sector (the test is '%s')",
-                       stest[c->surface_test]);
+    if (c->surface_test == LUB_SURFACE_SECTOR) {
+        const double sector = lub_dict_real_or(fs, "sectorAngle", 60.0, LUB_BETWEEN(10.0, 179.0));
+        c->cone_cos = cos(0.5 * sector * M_PI / 180.0);
+        /* default 150 degrees, or the sector's opening when that is wider */
+        const double exposed =
+            lub_dict_real_or(fs, "exposedAngle", fmax(150.0, sector), LUB_BETWEEN(10.0, 179.0));
+        if (exposed < sector)
+            lub_node_error(lub_dict_find(fs, "exposedAngle"),
+                           "freeSurface: exposedAngle (%g degrees) must be at least sectorAngle "
+                           "(%g degrees): an empty sector of exposedAngle makes a surface "
+                           "particle by itself, one of sectorAngle only where the surface "
+                           "reaches it",
+                           exposed, sector);
+        c->exposed_cos = cos(0.5 * exposed * M_PI / 180.0);
+    } else {
+        static const char *const only[] = {"sectorAngle", "exposedAngle"};
+        for (int k = 0; k < 2; k++)
+            if (lub_dict_find(fs, only[k]))
+                lub_node_error(lub_dict_find(fs, only[k]),
+                               "freeSurface: '%s' belongs to test: sector (the test is '%s')",
+                               only[k], stest[c->surface_test]);
+    }
     c->skin = lub_dict_real_or(r, "neighbourSkin", 0.0, LUB_BETWEEN(0.0, 1.0));
     c->lsmps_det_min =
         lub_dict_real_or(r, "lsmpsDetMin", LUB_MPS_LSMPS_DET_MIN, (lub_range){0.0, 1.0, 1, 1});

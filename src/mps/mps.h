@@ -77,6 +77,9 @@ typedef struct {
     double asymmetry;       /* centroid offset / l0 above which a low-PND particle is on the
                                surface (centroid and sector tests) */
     double cone_cos;        /* sector test: cosine of half the opening of the empty sector */
+    double exposed_cos;     /* sector test: the same of exposedAngle (<= cone_cos): a wider
+                               empty sector makes a surface particle by itself, a narrower one
+                               only where the surface reaches it (step.c, free_surface) */
     double skin;            /* neighbour search radius re (1 + skin) */
     double lsmps_det_min;   /* LSMPS fallback threshold */
     int lap_viscosity;      /* LUB_LAPLACIAN_*: the Laplacian of the viscous term */
@@ -190,6 +193,10 @@ struct lub_mps {
                         fields gradPx, gradPy, gradPz, so that it is saved and reordered) */
     double *cav;     /* negativePressure cavitation: 1 where the pressure is held at 0 (particle
                         extra field "cavitation", so that it is saved and reordered), else NULL */
+    double *surf;    /* sector test: 1 where the particle was on the free surface at the last
+                        step (particle extra field "surface": saved and reordered), else NULL */
+    int surf_fresh;  /* the start's particles carry no "surface" field: the first step takes
+                        the geometric test alone */
     double *lap;
     /* Given particles: the pressure-equation contributions (and the velocities) of a model,
      * set before the step (multiResolution's fixed band, T-25, T-26).  Reordered with the

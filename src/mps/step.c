@@ -71,6 +71,12 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
         m->gbar[d] = c->predictor > 0 && d < m->dim ? lub_particles_extra(P, gbar_names[d]) : NULL;
     m->cav =
         c->clip_negative == LUB_NEGATIVE_CAVITATION ? lub_particles_extra(P, "cavitation") : NULL;
+    m->surf = NULL;
+    m->surf_fresh = 0;
+    if (c->surface_test == LUB_SURFACE_SECTOR && c->exposed_cos < c->cone_cos) {
+        m->surf_fresh = lub_particles_find_extra(P, "surface") == NULL;
+        m->surf = lub_particles_extra(P, "surface");
+    }
     for (int d = 0; d < 3; d++) {
         m->us[d] = alloc_doubles(n);
         m->bv[d] = alloc_doubles(n);
@@ -584,6 +590,21 @@ static int open_side(const lub_mps *m, size_t i, const double c[3], double ccos)
  *     pressure to a third at that step (tests/unit/mps_test.c test_surface_film).  The
  *     sector test is applied after the centroid test, which keeps its cost to the few
  *     particles with a low PND and an off-centre neighbourhood.
+ *     The sector's opening tells a surface from a void: a particle on a free surface has an
+ *     empty half-plane in front of it (180 degrees, 150-180 in a dip of a rough surface, more
+ *     on a convex corner), while a void inside a full film, a hole of a few l0 that the
+ *     disordered particles leave for a step (a fluid particle in the peak of
+ *     tutorials/convergence/wedgeB at h0/12 saw 85 degrees), and a surface particle in a
+ *     concave corner (a meniscus against a wall) leave narrower gaps.  So an empty sector of
+ *     exposedAngle (default 150 degrees) makes a surface particle by itself; a narrower one of
+ *     at least sectorAngle only where the surface reaches it: the particle, or a neighbour
+ *     within re, was a surface particle at the step before (the "surface" field, saved with
+ *     the particles).  The surface spreads from outside as the thesis' virtual light does,
+ *     and a void that no surface reaches is no free surface: its PND deficit lowers its
+ *     pressure and the liquid closes it (negativePressure clip or cavitation keeps that
+ *     pressure at zero or above).  A trapped bubble, which was open to the outside when it
+ *     closed, keeps its surface.  The first step of a run whose particles carry no "surface"
+ *     field (the 0/ of particleGen) takes the geometric test alone.
  *   centroid: the weighted centroid of the neighbours is further than `asymmetry` l0 from
  *     the particle (alone: the test of the earlier builds).
  *   pnd: the PND test alone.
@@ -598,6 +619,8 @@ static void free_surface(lub_mps *m)
     const double lim = m->c.beta * m->n0, asym = m->c.asymmetry * m->l0;
     const int test = m->c.surface_test;
     const double ccos = m->c.cone_cos;
+    double *prev = m->surf;
+    const int reach = prev && !m->surf_fresh;
     size_t ns = 0;
 #pragma omp parallel for schedule(static) reduction(+ : ns)
     for (size_t i = 0; i < n; i++) {
@@ -619,12 +642,24 @@ static void free_surface(lub_mps *m)
                 else
                     s = (asym <= 0 || off > asym);
                 if (s && test == LUB_SURFACE_SECTOR) s = (uint8_t)open_side(m, i, c, ccos);
+                /* narrower than exposedAngle: a surface particle only where the surface
+                 * reaches it (the particle or a neighbour was one at the step before) */
+                if (s && reach && !(prev[i] > 0) && !open_side(m, i, c, m->c.exposed_cos)) {
+                    s = 0;
+                    for (size_t q = nb->start[i]; q < nb->end[i] && !s; q++)
+                        if (nb->w[q] > 0 && prev[nb->j[q]] > 0) s = 1;
+                }
             }
         }
         m->surface[i] = s;
         ns += s;
     }
     m->st.nsurface = ns;
+    if (prev) { /* this step's surface, for the next step's */
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++) prev[i] = m->surface[i];
+    }
+    m->surf_fresh = 0;
 }
 
 /* Groups of pressure unknowns connected, through the matrix, to no Dirichlet particle (a
