@@ -252,6 +252,61 @@ static void test_wide_limit(void)
     CHECK(err[1] / err[2] > 0.5 * exp(M_PI));
 }
 
+/* The other x conditions in the wide limit (W = 4 (xb - xa)): the mid-plane is the 1-D
+ * solution of the same condition on the same x grid, the given exit between two nodes (the
+ * cut cell) included; half-Sommerfeld clips, full-Sommerfeld keeps the negative loop. */
+static void test_wide_limit_conditions(void)
+{
+    const double s = sqrt(WL_R * WL_H0), xa = -4.0 * s, xb = 2.0 * s;
+    const int nx = 120;
+    double h[nx + 1], hf[nx];
+    wl_gap(nx, xa, xb, h, hf);
+    lub_reynolds_bc bcs[3] = {LUB_REYNOLDS_BC_HALF_SOMMERFELD, LUB_REYNOLDS_BC_FULL_SOMMERFELD,
+                              LUB_REYNOLDS_BC_GIVEN_EXIT};
+    for (int k = 0; k < 3; k++) {
+        lub_reynolds_problem p1;
+        lub_reynolds_problem_init(&p1);
+        p1.n = nx;
+        p1.xa = xa;
+        p1.xb = xb;
+        p1.h = h;
+        p1.h_face = hf;
+        p1.u1 = 1.0;
+        p1.mu = WL_MU;
+        p1.bc = bcs[k];
+        p1.exit_x = 0.37 * s; /* between nodes */
+        double q1[nx + 1];
+        lub_reynolds_result r1 = {.p = q1};
+        CHECK(lub_reynolds_solve(&p1, &r1) == LUB_REYNOLDS_OK);
+        lub_reynolds2d_problem pb;
+        lub_reynolds2d_problem_init(&pb);
+        pb.nx = nx;
+        pb.width = 4.0 * (xb - xa);
+        pb.nz = 60;
+        pb.xa = xa;
+        pb.xb = xb;
+        pb.h = h;
+        pb.h_face = hf;
+        pb.u1 = 1.0;
+        pb.mu = WL_MU;
+        pb.bc = bcs[k];
+        pb.exit_x = p1.exit_x;
+        double *p = malloc((size_t)(nx + 1) * (pb.nz + 1) * sizeof *p);
+        lub_reynolds2d_result r = {.p = p};
+        CHECK(lub_reynolds2d_solve(&pb, &r) == LUB_REYNOLDS_OK);
+        double e = 0.0, pmin = 0.0;
+        for (int i = 0; i <= nx; i++) {
+            double pm = p[lub_reynolds2d_index(&pb, i, pb.nz / 2)];
+            e = fmax(e, fabs(pm - q1[i]));
+            pmin = fmin(pmin, pm);
+        }
+        CHECK(e <= 1e-4 * r1.p_max);
+        CHECK(bcs[k] == LUB_REYNOLDS_BC_FULL_SOMMERFELD ? pmin < -0.1 * r1.p_max : pmin == 0.0);
+        if (bcs[k] == LUB_REYNOLDS_BC_GIVEN_EXIT) CHECK(r.x_exit == p1.exit_x);
+        free(p);
+    }
+}
+
 /* --- the short-bearing limit ------------------------------------------------------------ */
 
 /* (b) An inclined slider, h = h1 (1 - x/(2L)) (h1/h2 = 2), full Sommerfeld (p > 0 anyway in
@@ -346,6 +401,7 @@ int main(void)
     RUN(test_manufactured_order);
     RUN(test_manufactured_reynolds);
     RUN(test_wide_limit);
+    RUN(test_wide_limit_conditions);
     RUN(test_short_bearing);
     RUN(test_pcg_matches_cholmod);
     RUN(test_bad_input);
