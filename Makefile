@@ -12,6 +12,8 @@
 # becomes the test program build/tests/<name>_test.  Nothing needs to be listed here.
 #
 # SANITIZE=address builds into build-asan/ with AddressSanitizer (make SANITIZE=address test).
+# PETSC=0 builds without PETSc (the 'petsc' linear solver), PETSC=1 requires it; by default
+# it is built in when installed (bin/installDeps installs it).
 #
 # Code generation: OPT (default -O3) and ARCH (default -march=native: the processor building
 # is the one running, as on a workstation or a cluster's compute node; `make ARCH=` builds
@@ -42,6 +44,20 @@ HDF5_PC       := $(if $(shell pkg-config --exists hdf5-serial 2>/dev/null && ech
 PKGS          := yaml-0.1 $(HDF5_PC)
 PKG_CFLAGS    := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
 PKG_LIBS      := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
+# PETSc (Debian petsc-dev, with Open MPI, hypre and MUMPS): the solver 'petsc' of
+# system/solution.yaml (src/linalg/petsc_solver.h).  Built in when pkg-config finds PETSc and
+# Open MPI's C binding (the Debian PETSc.pc does not name mpi.h's folder); PETSC=0 leaves it
+# out, PETSC=1 requires it.  Only petsc_solver.c sees PETSc's and MPI's headers.
+PETSC_ORIGIN  := $(origin PETSC)
+PETSC         ?= $(if $(shell pkg-config --exists PETSc ompi-c 2>/dev/null && echo y),1,0)
+ifeq ($(PETSC),1)
+  PETSC_PC    := PETSc ompi-c
+  PETSC_CFLAGS := -DLUB_HAVE_PETSC $(shell pkg-config --cflags $(PETSC_PC))
+  PETSC_LIBS  := $(shell pkg-config --libs $(PETSC_PC))
+  ifeq ($(PETSC_LIBS),)
+    $(error PETSC=1 but pkg-config finds no PETSc and ompi-c: install petsc-dev (bin/installDeps))
+  endif
+endif
 CHOLMOD_INC   ?= $(firstword $(wildcard /usr/include/suitesparse /usr/local/include/suitesparse))
 CHOLMOD_LIBS  ?= -lcholmod -lsuitesparseconfig
 
@@ -51,7 +67,7 @@ GITREV   := $(shell git rev-parse --short HEAD 2>/dev/null || echo unknown)
 CPPFLAGS += -Isrc $(if $(CHOLMOD_INC),-I$(CHOLMOD_INC)) $(PKG_CFLAGS) \
             -D_POSIX_C_SOURCE=200809L -DLUB_VERSION='"$(VERSION)"' -DLUB_GITREV='"$(GITREV)"'
 CFLAGS   += -std=c11 $(OPT) $(ARCH) -ffp-contract=off -fno-math-errno -g -Wall -Wextra -fopenmp -MMD -MP
-LDLIBS   += $(PKG_LIBS) $(CHOLMOD_LIBS) -lm
+LDLIBS   += $(PKG_LIBS) $(CHOLMOD_LIBS) $(PETSC_LIBS) -lm
 LDFLAGS  += -fopenmp $(LDSAN)
 
 LIB_SRC   := $(sort $(shell find src -name '*.c'))
@@ -75,13 +91,15 @@ all: $(LIB) $(BINS)
 # The code-generation flags of the objects in $(BUILD): rewritten (and so newer than every
 # object) only when they change.
 FLAGS_STAMP := $(BUILD)/flags
-FLAGS_NOW   := $(CC) $(OPT) $(ARCH) -fno-math-errno
+FLAGS_NOW   := $(CC) $(OPT) $(ARCH) -fno-math-errno PETSC=$(PETSC)
 $(shell mkdir -p $(BUILD) && { [ "$$(cat $(FLAGS_STAMP) 2>/dev/null)" = '$(FLAGS_NOW)' ] \
           || echo '$(FLAGS_NOW)' > $(FLAGS_STAMP); })
 
 $(BUILD)/obj/%.o: %.c $(FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
+
+$(BUILD)/obj/src/linalg/petsc_solver.o: CPPFLAGS += $(PETSC_CFLAGS)
 
 $(LIB): $(LIB_OBJ)
 	@mkdir -p $(dir $@)
@@ -113,9 +131,11 @@ $(BUILD)/bench/%_bench: $(BUILD)/obj/tests/bench/%_bench.o $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
-# deps: install missing Debian packages only when pkg-config or the CHOLMOD header is missing.
+# deps: install missing Debian packages only when pkg-config or the CHOLMOD header is missing
+# (PETSc too, unless PETSC=0 was asked for).
+PETSC_DEP := $(if $(and $(filter command environment,$(PETSC_ORIGIN)),$(filter 0,$(PETSC))),,PETSc ompi-c)
 deps:
-	@pkg-config --exists $(PKGS) 2>/dev/null && [ -n "$(CHOLMOD_INC)" ] \
+	@pkg-config --exists $(PKGS) $(PETSC_DEP) 2>/dev/null && [ -n "$(CHOLMOD_INC)" ] \
 	  && command -v gnuplot >/dev/null || bin/installDeps
 
 # The recursive make re-reads pkg-config after deps may have installed packages.
@@ -147,7 +167,7 @@ $(BUILD)/lubkit.pc:
 	@{ echo 'prefix=$(PREFIX)'; echo 'libdir=$${prefix}/lib'; \
 	   echo 'includedir=$${prefix}/include'; echo; echo 'Name: lubkit'; \
 	   echo 'Description: MPS thin-film lubrication toolkit: the core library liblub'; \
-	   echo 'Version: $(VERSION)'; echo 'Requires: $(PKGS)'; \
+	   echo 'Version: $(VERSION)'; echo 'Requires: $(PKGS) $(PETSC_PC)'; \
 	   echo 'Cflags: -I$${includedir}/lubkit $(if $(CHOLMOD_INC),-I$(CHOLMOD_INC)) -fopenmp'; \
 	   echo 'Libs: -L$${libdir} -llub $(CHOLMOD_LIBS) -lm -fopenmp $(LDSAN)'; } >$@
 

@@ -6,7 +6,7 @@
 
 #include "core/error.h"
 
-const char *const lub_linsolver_choice_names[] = {"cholmod", "pcg", NULL};
+const char *const lub_linsolver_choice_names[] = {"cholmod", "pcg", "petsc", NULL};
 
 lub_linsolver_options lub_linsolver_defaults(void)
 {
@@ -15,6 +15,7 @@ lub_linsolver_options lub_linsolver_defaults(void)
     o.kind = LUB_LINSOLVER_PCG;
     o.pcg = lub_pcg_defaults();
     o.cholmod = lub_cholmod_defaults();
+    o.petsc = lub_petsc_defaults();
     o.pattern = LUB_PATTERN_COMPARE;
     return o;
 }
@@ -26,6 +27,8 @@ void lub_linsolver_init(lub_linsolver *s, const lub_linsolver_options *o)
     lub_pcg_work_init(&s->pcg);
     if (o->kind == LUB_LINSOLVER_CHOLMOD)
         s->chol = lub_cholmod_new(&o->cholmod);
+    else if (o->kind == LUB_LINSOLVER_PETSC)
+        s->petsc = lub_petsc_new(&o->petsc);
     else if (o->kind != LUB_LINSOLVER_PCG)
         lub_bug("unknown linear solver %d", (int)o->kind);
 }
@@ -34,6 +37,7 @@ void lub_linsolver_free(lub_linsolver *s)
 {
     lub_pcg_work_free(&s->pcg);
     lub_cholmod_free(s->chol);
+    lub_petsc_free(s->petsc);
     memset(s, 0, sizeof *s);
 }
 
@@ -43,6 +47,11 @@ void lub_linsolver_describe(const lub_linsolver *s, char *buf, size_t size)
         snprintf(buf, size, "cholmod (ordering %s, %s)",
                  lub_cholmod_ordering_names[s->o.cholmod.ordering],
                  lub_cholmod_factor_names[s->o.cholmod.factor]);
+    } else if (s->o.kind == LUB_LINSOLVER_PETSC) {
+        snprintf(buf, size, "petsc (ksp %s, pc %s%s), tolerance %g, maxIter %d%s",
+                 lub_petsc_ksp_names[s->o.petsc.ksp], lub_petsc_pc_names[s->o.petsc.pc],
+                 s->o.petsc.pc == LUB_PETSC_PC_HYPRE ? " BoomerAMG" : "", s->o.pcg.tolerance,
+                 s->o.pcg.max_iter, s->o.pcg.warm_start ? ", warm start" : "");
     } else {
         snprintf(buf, size, "pcg (%s%s), tolerance %g, maxIter %d%s",
                  lub_precond_choice_names[s->o.pcg.precond],
@@ -60,6 +69,8 @@ lub_solve_status lub_linsolver_setup(lub_linsolver *s, const lub_csr *A, lub_sol
     s->ready = 0;
     if (s->o.kind == LUB_LINSOLVER_CHOLMOD) {
         lub_cholmod_factorize(s->chol, A, s->o.pattern, res);
+    } else if (s->o.kind == LUB_LINSOLVER_PETSC) {
+        lub_petsc_setup(s->petsc, A, &s->o.pcg, res);
     } else {
         memset(res, 0, sizeof *res);
         res->column = -1;
@@ -85,6 +96,8 @@ lub_solve_status lub_linsolver_solve(lub_linsolver *s, const lub_csr *A, int nrh
         return s->setup_result.status;
     }
     if (s->o.kind == LUB_LINSOLVER_CHOLMOD) return lub_cholmod_solve(s->chol, A, nrhs, b, x, res);
+    if (s->o.kind == LUB_LINSOLVER_PETSC)
+        return lub_petsc_solve(s->petsc, A, nrhs, b, x, &s->o.pcg, res);
     lub_solve_status worst = LUB_SOLVE_OK;
     for (int k0 = 0; k0 < nrhs; k0 += LUB_PCG_MAX_RHS) {
         const int m = nrhs - k0 < LUB_PCG_MAX_RHS ? nrhs - k0 : LUB_PCG_MAX_RHS;

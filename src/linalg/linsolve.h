@@ -2,11 +2,13 @@
  * system/solution.yaml (issue 4), e.g.
  *
  *     p:                          # pressure Poisson equation (T-9)
- *       solver: pcg               # lub_linsolver_choice_names: cholmod | pcg
+ *       solver: pcg               # lub_linsolver_choice_names: cholmod | pcg | petsc
  *       preconditioner: amg       # none | jacobi | ic0 | sgs | bic0 | amg
  *       tolerance: 1e-8           # relative residual ||b - A x|| / ||b|| (pcg)
  *       maxIter: 1000             # (pcg)
  *       warmStart: true           # start from the previous solution (pcg)
+ *       ksp: cg                   # petsc: cg | gmres | bcgs (petsc_solver.h)
+ *       pc: hypre                 # petsc: hypre (BoomerAMG) | gamg | jacobi | ...
  *
  * The reader of the dictionary (the solver) fills lub_linsolver_options with
  * lub_dict_choice(map, "solver", lub_linsolver_choice_names, LUB_LINSOLVER_PCG) and so on;
@@ -25,16 +27,23 @@
 #include "linalg/cholmod_solver.h"
 #include "linalg/csr.h"
 #include "linalg/pcg.h"
+#include "linalg/petsc_solver.h"
 #include "linalg/solve_result.h"
 
-typedef enum { LUB_LINSOLVER_CHOLMOD = 0, LUB_LINSOLVER_PCG = 1 } lub_linsolver_kind;
+typedef enum {
+    LUB_LINSOLVER_CHOLMOD = 0,
+    LUB_LINSOLVER_PCG = 1,
+    LUB_LINSOLVER_PETSC = 2 /* only where lub_petsc_available() */
+} lub_linsolver_kind;
 
 /* NULL-terminated, indexed by lub_linsolver_kind (for lub_dict_choice). */
 extern const char *const lub_linsolver_choice_names[];
 
 typedef struct lub_linsolver_options {
     lub_linsolver_kind kind;
-    lub_pcg_options pcg;         /* tolerance, max_iter, precond, warm_start, omega */
+    lub_pcg_options pcg;         /* tolerance, max_iter, precond, warm_start, omega (and the
+                                    tolerance, max_iter, warm_start of petsc) */
+    lub_petsc_options petsc;     /* ksp, pc */
     lub_cholmod_options cholmod; /* ordering, factor kind */
     lub_pattern_hint pattern;    /* cholmod: how to decide on re-analysis (COMPARE) */
 } lub_linsolver_options;
@@ -46,6 +55,7 @@ typedef struct lub_linsolver {
     lub_linsolver_options o;
     lub_pcg_work pcg;
     lub_cholmod *chol; /* NULL unless kind == cholmod */
+    lub_petsc *petsc;  /* NULL unless kind == petsc */
     const lub_csr *A;  /* matrix of the last successful set-up, and its stamp */
     unsigned long stamp;
     lub_solve_result setup_result; /* of the last set-up (cholmod: NOT_POSDEF + column) */

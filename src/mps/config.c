@@ -21,6 +21,7 @@
  *     p: { solver: pcg, preconditioner: amg, cycle: W, tolerance: 1e-8, maxIter: 2000,
  *          warmStart: true, onFailure: stop }          # cycle V | W; stop | continue
  *     U: { solver: pcg, preconditioner: jacobi, tolerance: 1e-8, maxIter: 500 }
+ *     (solver petsc: ksp cg | gmres | bcgs, pc hypre | gamg | jacobi | bjacobi | sor | none)
  */
 #include <math.h>
 #include <stdio.h>
@@ -76,6 +77,12 @@ static void read_linsolver(lub_node *map, lub_linsolver_options *o, int *cont)
     static const char *const fail[] = {"stop", "continue", NULL};
     if (!map) return;
     o->kind = lub_dict_choice(map, "solver", lub_linsolver_choice_names, o->kind);
+    if (o->kind == LUB_LINSOLVER_PETSC && !lub_petsc_available())
+        lub_node_error(lub_dict_find(map, "solver"),
+                       "solver 'petsc': this lubkit was built without PETSc (install petsc-dev, "
+                       "e.g. bin/installDeps, and rebuild: make), or choose cholmod or pcg");
+    o->petsc.ksp = lub_dict_choice(map, "ksp", lub_petsc_ksp_names, o->petsc.ksp);
+    o->petsc.pc = lub_dict_choice(map, "pc", lub_petsc_pc_names, o->petsc.pc);
     o->pcg.precond =
         lub_dict_choice(map, "preconditioner", lub_precond_choice_names, o->pcg.precond);
     o->pcg.tolerance =

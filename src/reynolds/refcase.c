@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "linalg/linsolve.h"
 #include "models/models.h"
 #include "models/transport.h"
 #include "reynolds/reynolds.h"
@@ -58,6 +59,23 @@ static void settings_read(lub_refcase_settings *s, const char *path)
     s->ehl_mode = lub_dict_choice(se, "mode", lub_refcase_ehl_modes, LUB_REFCASE_EHL_AUTO);
     s->ehl_tolerance = lub_dict_real_or(se, "tolerance", 1e-8, (lub_range){0.0, 1e-3, 1, 0});
     s->ehl_max_iterations = lub_dict_int_or(se, "maxIterations", 400, 1, 1000000);
+    /* the finite width (reynolds2d.h): nz and linearSolver belong to it */
+    s->width_node = lub_dict_find(root, "width");
+    s->width = lub_dict_real_or(root, "width", 0.0, LUB_POSITIVE);
+    lub_node *nz = lub_dict_find(root, "nz"), *ls = lub_dict_find(root, "linearSolver");
+    if (!s->width_node && (nz || ls))
+        lub_node_error(nz ? nz : ls,
+                       "'%s' belongs to the finite-width reference: give 'width' too (the "
+                       "bearing's length across the motion, m)",
+                       nz ? "nz" : "linearSolver");
+    s->nz = lub_dict_int_or(root, "nz", 32, 2, 100000);
+    if (s->nz % 2)
+        lub_node_error(nz,
+                       "'nz' must be even, so that the mid-plane z = 0 is a grid line "
+                       "(found %ld)",
+                       s->nz);
+    static const char *const solvers[] = {"cholmod", "pcg", NULL}; /* lub_linsolver_kind */
+    s->solver = lub_dict_choice(root, "linearSolver", solvers, LUB_LINSOLVER_CHOLMOD);
     lub_dict_finish(s->dict);
 }
 
@@ -133,6 +151,10 @@ void lub_refcase_read(lub_refcase *rc, const lub_case *c)
                        "soft EHL solves the free exit: 'boundaryCondition' must be 'reynolds' "
                        "(found '%s'), or set 'softEHL: {mode: off}' for the rigid reference",
                        lub_reynolds_bc_names[s->bc]);
+    if (rc->ehl && s->width_node)
+        lub_node_error(s->width_node,
+                       "the finite-width reference is rigid: remove 'width', or set 'softEHL: "
+                       "{mode: off}' for the rigid reference over the width");
     if (rc->ehl && s->cells > 8000)
         lub_node_error(s->cells_node,
                        "soft EHL solves a dense Newton system (time ~ cells^3, 0.05 s per "

@@ -56,6 +56,10 @@ typedef struct {
     lub_node *ehl_mode_node; /* softEHL.mode entry (or NULL) */
     double ehl_tolerance;    /* softEHL.tolerance: film change and load error */
     long ehl_max_iterations; /* softEHL.maxIterations: Newton iterations */
+    double width;            /* width: > 0 the finite-width (2-D) reference, 0: 1-D */
+    lub_node *width_node;    /* width entry (or NULL) */
+    long nz;                 /* nz: cells across the width (even) */
+    int solver;              /* linearSolver: lub_linsolver_kind (2-D only) */
 } lub_refcase_settings;
 
 /* Everything the reference reads from a case. */

@@ -1239,7 +1239,8 @@ static void test_linsolver_names(void)
 {
     CHECK(strcmp(lub_linsolver_choice_names[LUB_LINSOLVER_CHOLMOD], "cholmod") == 0);
     CHECK(strcmp(lub_linsolver_choice_names[LUB_LINSOLVER_PCG], "pcg") == 0);
-    CHECK(lub_linsolver_choice_names[2] == NULL);
+    CHECK(strcmp(lub_linsolver_choice_names[LUB_LINSOLVER_PETSC], "petsc") == 0);
+    CHECK(lub_linsolver_choice_names[3] == NULL);
     CHECK(strcmp(lub_precond_choice_names[LUB_PRECOND_JACOBI], "jacobi") == 0);
     CHECK(strcmp(lub_precond_choice_names[LUB_PRECOND_IC0], "ic0") == 0);
     CHECK(strcmp(lub_precond_choice_names[LUB_PRECOND_SGS], "sgs") == 0);

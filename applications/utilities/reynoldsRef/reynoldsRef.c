@@ -25,6 +25,7 @@
 #include "io/table.h"
 #include "reynolds/refcase.h"
 #include "reynolds/reynolds.h"
+#include "reynolds/reynolds2d.h"
 #include "reynoldsRef.h"
 
 void reynoldsRef_table_write(const lub_case *c, const char *out_file, const char *tname,
@@ -123,6 +124,122 @@ static void reference(const lub_case *c, const lub_refcase *rc, const lub_refgap
     free(p);
 }
 
+/* p(x, z) as "# x z p" rows, a blank line after each x column (gnuplot's splot reads the
+ * grid), to postProcessing/reynoldsRef/<tname>/p2d.dat. */
+static void table2d_write(const lub_case *c, const char *tname, const lub_reynolds2d_problem *pb,
+                          const double *p, char *written)
+{
+    char path[LUB_PATH_MAX];
+    lub_output o;
+    lub_postproc_path(c, "reynoldsRef", tname, "p2d.dat", path);
+    lub_output_open(&o, path);
+    lub_table_write_header(o.fp, "x[m] z[m] p[Pa]");
+    double dx = (pb->xb - pb->xa) / pb->nx;
+    for (int i = 0; i <= pb->nx; i++) {
+        for (int j = 0; j <= pb->nz; j++) {
+            double row[3] = {pb->xa + i * dx, lub_reynolds2d_z(pb, j),
+                             p[lub_reynolds2d_index(pb, i, j)]};
+            lub_table_write_row(o.fp, row, 3);
+        }
+        fputc('\n', o.fp);
+    }
+    lub_output_close(&o);
+    snprintf(written, LUB_PATH_MAX, "postProcessing/reynoldsRef/%s/p2d.dat", tname);
+}
+
+/* The finite-width reference (width in reynoldsRefDict.yaml, reynolds2d.h) at the walls'
+ * time: solve over the area, write p2d.dat and the mid-plane's p.dat, report. */
+static void reference2d(const lub_case *c, const lub_refcase *rc, const lub_refgap *G,
+                        const char *out_file, const char *tname, int dimensionless, double t_start)
+{
+    const lub_refcase_settings *s = &rc->s;
+    lub_reynolds2d_problem pb;
+    lub_reynolds2d_problem_init(&pb);
+    pb.nx = G->n;
+    pb.nz = (int)s->nz;
+    pb.xa = G->xa;
+    pb.xb = G->xb;
+    pb.width = s->width;
+    pb.h = G->h;
+    pb.h_face = G->hf;
+    pb.dhdt_nodes = G->dhdt;
+    pb.u1 = rc->u1;
+    pb.u2 = rc->u2;
+    pb.mu = rc->mu;
+    pb.bc = (lub_reynolds_bc)s->bc;
+    pb.exit_x = s->exit_x;
+    pb.tolerance = s->tolerance;
+    pb.max_iterations = (int)s->max_iterations;
+    lub_linsolver_options lo = lub_linsolver_defaults();
+    lo.kind = (lub_linsolver_kind)s->solver;
+    lo.pcg.precond = LUB_PRECOND_AMG;
+    lo.pcg.tolerance = 1e-11;
+    lo.pcg.max_iter = 10000;
+    pb.solver = &lo;
+    size_t nn = (size_t)(pb.nx + 1) * (pb.nz + 1);
+    double *p = lub_malloc(nn * sizeof *p), *mid = lub_malloc((size_t)(pb.nx + 1) * sizeof *mid);
+    lub_reynolds2d_result res = {.p = p};
+    double t_solve = lub_wtime();
+    lub_reynolds_status st = lub_reynolds2d_solve(&pb, &res);
+    t_solve = lub_wtime() - t_solve;
+    if (st != LUB_REYNOLDS_OK)
+        lub_fatal_run("the 2-D Reynolds solve failed: %s (%d x %d cells on [%g, %g] x [%g, %g], "
+                      "%s, t = %g s)",
+                      lub_reynolds_status_string(st), pb.nx, pb.nz, G->xa, G->xb, -0.5 * pb.width,
+                      0.5 * pb.width, lub_reynolds_bc_names[s->bc], rc->t);
+    for (int i = 0; i <= pb.nx; i++) mid[i] = p[lub_reynolds2d_index(&pb, i, pb.nz / 2)];
+
+    lub_refscales d;
+    if (dimensionless) lub_refcase_scales(rc, G, &d);
+    char written[LUB_PATH_MAX], written2d[LUB_PATH_MAX] = "";
+    reynoldsRef_table_write(c, out_file, tname, G, G->h, mid, dimensionless ? &d : NULL, written);
+    if (!out_file) table2d_write(c, tname, &pb, p, written2d);
+
+    lub_message("grid        %d x %d cells on [%g, %g] x [%g, %g] m, dx = %.4g m, dz = %.4g m",
+                pb.nx, pb.nz, G->xa, G->xb, -0.5 * pb.width, 0.5 * pb.width, G->dx,
+                pb.width / pb.nz);
+    lub_message("walls       lower '%s' U1 = %g m/s, upper '%s' U2 = %g m/s%s", s->lower, rc->u1,
+                s->upper, rc->u2, G->moving_shape ? ", dh/dt != 0 (wall motion)" : "");
+    lub_message("oil         rho = %g kg/m^3, nu = %g m^2/s, mu = %g Pa s", rc->rho, rc->nu,
+                rc->mu);
+    lub_message("gap         h0 = %.6g m (minimum, at x = %.6g m), uniform across the width", G->h0,
+                G->x_h0);
+    lub_message("condition   %s, p = 0 at the sides z = +-%g m%s", lub_reynolds_bc_names[s->bc],
+                0.5 * pb.width,
+                s->bc == LUB_REYNOLDS_BC_REYNOLDS ? " (p >= 0; p = dp/dx = 0 at the free exit)"
+                                                  : "");
+    lub_message("solver      %s", lo.kind == LUB_LINSOLVER_CHOLMOD ? "cholmod" : "pcg (amg)");
+    if (s->bc == LUB_REYNOLDS_BC_REYNOLDS)
+        lub_message("active set  %d iteration%s (all grid levels), %d cavitated nodes",
+                    res.iterations, res.iterations == 1 ? "" : "s", res.n_cavitated);
+    if (lo.kind == LUB_LINSOLVER_PCG)
+        lub_message("pcg         %d iterations in all", res.linear_iters);
+    lub_message("exit        x = %.6g m at the mid-plane%s", res.x_exit,
+                res.x_exit >= G->xb ? " (the outlet: the film is full up to it)" : "");
+    lub_message("peak        p = %.6g Pa at x = %.6g m, z = %.6g m", res.p_max, res.x_max,
+                res.z_max);
+    lub_message("load        W = %.6g N (%.6g N/m over the width)", res.load, res.load / pb.width);
+    /* the outlet's flow only where the film is full: a cavitated film does not conserve
+     * volume in the Reynolds model (Um h is carried on through it) */
+    if (s->bc == LUB_REYNOLDS_BC_FULL_SOMMERFELD)
+        lub_message("leakage     Q = %.6g m^3/s out of the sides (inlet %.6g, outlet %.6g m^3/s)",
+                    res.leakage, res.q_in, res.q_out);
+    else
+        lub_message("leakage     Q = %.6g m^3/s out of the sides (inlet %.6g m^3/s)", res.leakage,
+                    res.q_in);
+    if (dimensionless) {
+        lub_message("R, h0       R = %g m, h0 = %g m, sqrt(R h0) = %.6g m", d.radius, G->h0, d.sx);
+        lub_message("peak        P = %.5f (all nodes)", res.p_max * d.sp);
+        lub_message("load        W h0/(mu (U1+U2) R B) = %.5f (B the width)",
+                    res.load / pb.width * G->h0 / (rc->mu * d.uref * d.radius));
+    }
+    lub_message("written     %s (the mid-plane z = 0)", written);
+    if (written2d[0]) lub_message("written     %s", written2d);
+    lub_message("time        solve %.3g s, total %.3g s", t_solve, lub_wtime() - t_start);
+    free(p);
+    free(mid);
+}
+
 int main(int argc, char **argv)
 {
     static int dimensionless = 0;
@@ -170,7 +287,15 @@ int main(int argc, char **argv)
             "h = h0 + x^2/(2R) + v(x), v from the half-space influence coefficients (thesis\n"
             "T-46..T-49) applied to the pressure, and h0 such that the integral of p is W\n"
             "are solved together with the Reynolds equation (Newton's method).  Reports\n"
-            "h_min, h(0), the peak, the exit and the load error.",
+            "h_min, h(0), the peak, the exit and the load error.\n"
+            "Finite width ('width' in reynoldsRefDict.yaml, with 'nz' cells across): the\n"
+            "2-D Reynolds equation over the bearing's area, z across the motion,\n"
+            "  d/dx(h^3/(12 mu) dp/dx) + d/dz(h^3/(12 mu) dp/dz) = (U1+U2)/2 dh/dx + dh/dt\n"
+            "with the gap uniform in z, p = 0 at the sides z = +-width/2 and the same x\n"
+            "conditions; solved by CHOLMOD (or 'linearSolver: pcg', with AMG).  Writes\n"
+            "p2d.dat (x z p, a blank line between x columns: gnuplot splot) beside p.dat,\n"
+            "which then holds the mid-plane z = 0, and reports the load [N] and the side\n"
+            "leakage [m^3/s] (doc/methods.md 5.6).",
         .dictionaries = "system/reynoldsRefDict.yaml\nsystem/particleGenDict.yaml\n"
                         "constant/transportProperties.yaml\nconstant/models.yaml\n"
                         "system/controlDict.yaml (timePrecision, optional)",
@@ -235,6 +360,8 @@ int main(int argc, char **argv)
         report_time(&rc, &G);
         if (rc.ehl) /* soft EHL: the gap follows from the pressure (reynoldsRefEHL.c) */
             reynoldsRef_soft_ehl(&c, &rc, &G, out_file, times[k].name, dimensionless, t_start);
+        else if (s->width > 0.0) /* the finite width */
+            reference2d(&c, &rc, &G, out_file, times[k].name, dimensionless, t_start);
         else
             reference(&c, &rc, &G, out_file, times[k].name, dimensionless, t_start);
         lub_refgap_free(&G);

@@ -1,0 +1,294 @@
+/* lubkit linalg: PETSc KSP solvers (see petsc_solver.h).  Compiled with PETSc's flags only
+ * when the build has PETSc (Makefile: PETSC=1 defines LUB_HAVE_PETSC for this file). */
+#include "linalg/petsc_solver.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+
+const char *const lub_petsc_ksp_names[] = {"cg", "gmres", "bcgs", NULL};
+const char *const lub_petsc_pc_names[] = {"hypre", "gamg", "jacobi", "bjacobi",
+                                          "sor",   "none", NULL};
+
+lub_petsc_options lub_petsc_defaults(void)
+{
+    lub_petsc_options o = {LUB_PETSC_KSP_CG, LUB_PETSC_PC_HYPRE};
+    return o;
+}
+
+#ifndef LUB_HAVE_PETSC
+
+int lub_petsc_available(void)
+{
+    return 0;
+}
+const char *lub_petsc_version(void)
+{
+    return "no PETSc in this build";
+}
+lub_petsc *lub_petsc_new(const lub_petsc_options *o)
+{
+    (void)o;
+    lub_bug("lub_petsc_new in a build without PETSc");
+}
+void lub_petsc_free(lub_petsc *s)
+{
+    (void)s;
+}
+lub_solve_status lub_petsc_setup(lub_petsc *s, const lub_csr *A, const lub_pcg_options *o,
+                                 lub_solve_result *res)
+{
+    (void)s, (void)A, (void)o, (void)res;
+    lub_bug("lub_petsc_setup in a build without PETSc");
+}
+lub_solve_status lub_petsc_solve(lub_petsc *s, const lub_csr *A, int nrhs, const double *const *b,
+                                 double *const *x, const lub_pcg_options *o, lub_solve_result *res)
+{
+    (void)s, (void)A, (void)nrhs, (void)b, (void)x, (void)o, (void)res;
+    lub_bug("lub_petsc_solve in a build without PETSc");
+}
+
+#else
+
+#include <petscksp.h>
+
+_Static_assert(sizeof(PetscInt) == sizeof(int), "lub_csr's int indices are PetscInt");
+_Static_assert(sizeof(PetscScalar) == sizeof(double), "a real, double PETSc");
+
+struct lub_petsc {
+    lub_petsc_options o;
+    MPI_Comm comm;
+    Mat A;
+    Vec b, x;
+    KSP ksp;
+    int n, nnz;     /* size of A and of the vectors (0: none yet) */
+    int *ptr, *col; /* the pattern A was made with (MatUpdateMPIAIJWithArrays needs it) */
+    int n_cap, nnz_cap;
+    double *r;         /* residual work, n_cap */
+    const lub_csr *As; /* the CSR and stamp of the last set-up */
+    unsigned long stamp;
+    int ready;
+};
+
+static char version[64];
+
+static void petsc_finish(void)
+{
+    PetscBool up = PETSC_FALSE, down = PETSC_FALSE;
+    PetscInitialized(&up);
+    PetscFinalized(&down);
+    if (up && !down) PetscFinalize();
+}
+
+/* Start PETSc once: no signal handlers of its own (lubFoam's SIGINT/SIGTERM stop is
+ * lubFoam's), no options from a command line it does not own; finalised at exit. */
+static void petsc_start(void)
+{
+    PetscBool up = PETSC_FALSE;
+    PetscInitialized(&up);
+    if (up) return;
+    if (PetscOptionsSetValue(NULL, "-no_signal_handler", "true") || PetscInitializeNoArguments())
+        lub_fatal_run("PETSc did not start (PetscInitialize failed: MPI?)");
+    atexit(petsc_finish);
+}
+
+int lub_petsc_available(void)
+{
+    return 1;
+}
+
+const char *lub_petsc_version(void)
+{
+    if (!version[0])
+        snprintf(version, sizeof version, "PETSc %d.%d.%d", PETSC_VERSION_MAJOR,
+                 PETSC_VERSION_MINOR, PETSC_VERSION_SUBMINOR);
+    return version;
+}
+
+lub_petsc *lub_petsc_new(const lub_petsc_options *o)
+{
+    petsc_start();
+    lub_petsc *s = lub_calloc(1, sizeof *s);
+    s->o = *o;
+    s->comm = PETSC_COMM_SELF;
+    return s;
+}
+
+static void destroy_objects(lub_petsc *s)
+{
+    if (s->ksp) KSPDestroy(&s->ksp);
+    if (s->A) MatDestroy(&s->A);
+    if (s->b) VecDestroy(&s->b);
+    if (s->x) VecDestroy(&s->x);
+    s->n = s->nnz = 0;
+}
+
+void lub_petsc_free(lub_petsc *s)
+{
+    if (!s) return;
+    destroy_objects(s);
+    free(s->ptr);
+    free(s->col);
+    free(s->r);
+    free(s);
+}
+
+/* PETSc calls return an error code; PETSc has printed the trace when it is not 0. */
+#define TRY(call)                                                                                  \
+    do {                                                                                           \
+        if ((call) != 0) goto fail;                                                                \
+    } while (0)
+
+static int same_pattern(const lub_petsc *s, const lub_csr *A)
+{
+    return s->A && s->n == A->n && s->nnz == A->nnz &&
+           !memcmp(s->ptr, A->row_ptr, (size_t)(A->n + 1) * sizeof *s->ptr) &&
+           !memcmp(s->col, A->col, (size_t)A->nnz * sizeof *s->col);
+}
+
+/* The KSP with its method, preconditioner and norm, made once per matrix object. */
+static int make_ksp(lub_petsc *s)
+{
+    static const char *const kt[] = {KSPCG, KSPGMRES, KSPBCGS};
+    static const char *const pt[] = {PCHYPRE, PCGAMG, PCJACOBI, PCBJACOBI, PCSOR, PCNONE};
+    PC pc;
+    TRY(KSPCreate(s->comm, &s->ksp));
+    TRY(KSPSetType(s->ksp, kt[s->o.ksp]));
+    TRY(KSPGetPC(s->ksp, &pc));
+    TRY(PCSetType(pc, pt[s->o.pc]));
+    if (s->o.pc == LUB_PETSC_PC_HYPRE) TRY(PCHYPRESetType(pc, "boomeramg"));
+    /* ||b - A x|| / ||b|| as lubkit's PCG: GMRES only knows it with right preconditioning */
+    if (s->o.ksp == LUB_PETSC_KSP_GMRES) TRY(KSPSetPCSide(s->ksp, PC_RIGHT));
+    TRY(KSPSetNormType(s->ksp, KSP_NORM_UNPRECONDITIONED));
+    TRY(KSPSetFromOptions(s->ksp));
+    return 0;
+fail:
+    return -1;
+}
+
+lub_solve_status lub_petsc_setup(lub_petsc *s, const lub_csr *A, const lub_pcg_options *o,
+                                 lub_solve_result *res)
+{
+    (void)o;
+    memset(res, 0, sizeof *res);
+    res->column = -1;
+    res->status = LUB_SOLVE_FAILED;
+    s->ready = 0;
+    if (same_pattern(s, A)) {
+        /* the values only, into the matrix PETSc already holds */
+        TRY(MatUpdateMPIAIJWithArrays(s->A, A->n, A->n, A->n, A->n, A->row_ptr, A->col, A->val));
+    } else {
+        destroy_objects(s);
+        if (A->n > s->n_cap) {
+            free(s->ptr);
+            free(s->r);
+            s->ptr = lub_malloc((size_t)(A->n + 1) * sizeof *s->ptr);
+            s->r = lub_malloc((size_t)A->n * sizeof *s->r);
+            s->n_cap = A->n;
+        }
+        if (A->nnz > s->nnz_cap) {
+            free(s->col);
+            s->col = lub_malloc((size_t)A->nnz * sizeof *s->col);
+            s->nnz_cap = A->nnz;
+        }
+        memcpy(s->ptr, A->row_ptr, (size_t)(A->n + 1) * sizeof *s->ptr);
+        memcpy(s->col, A->col, (size_t)A->nnz * sizeof *s->col);
+        /* this process's rows (all of them on one), global columns */
+        TRY(MatCreateMPIAIJWithArrays(s->comm, A->n, A->n, A->n, A->n, A->row_ptr, A->col, A->val,
+                                      &s->A));
+        TRY(MatSetOption(s->A, MAT_SYMMETRIC, PETSC_TRUE));
+        TRY(MatSetOption(s->A, MAT_SPD, PETSC_TRUE));
+        TRY(VecCreateMPIWithArray(s->comm, 1, A->n, A->n, NULL, &s->b));
+        TRY(VecCreateMPIWithArray(s->comm, 1, A->n, A->n, NULL, &s->x));
+        s->n = A->n;
+        s->nnz = A->nnz;
+        if (make_ksp(s)) goto fail;
+    }
+    TRY(KSPSetOperators(s->ksp, s->A, s->A));
+    TRY(KSPSetUp(s->ksp));
+    res->status = LUB_SOLVE_OK;
+    res->converged = 1;
+    s->As = A;
+    s->stamp = A->stamp;
+    s->ready = 1;
+    return LUB_SOLVE_OK;
+fail:
+    destroy_objects(s); /* start afresh next time */
+    return res->status;
+}
+
+static lub_solve_status reason_status(KSPConvergedReason why)
+{
+    if (why > 0) return LUB_SOLVE_OK;
+    switch (why) {
+    case KSP_DIVERGED_ITS:
+        return LUB_SOLVE_NOT_CONVERGED;
+    case KSP_DIVERGED_NANORINF:
+        return LUB_SOLVE_NONFINITE;
+    case KSP_DIVERGED_BREAKDOWN:
+    case KSP_DIVERGED_BREAKDOWN_BICG:
+    case KSP_DIVERGED_INDEFINITE_PC:
+    case KSP_DIVERGED_INDEFINITE_MAT:
+        return LUB_SOLVE_BREAKDOWN;
+    default:
+        return LUB_SOLVE_FAILED;
+    }
+}
+
+lub_solve_status lub_petsc_solve(lub_petsc *s, const lub_csr *A, int nrhs, const double *const *b,
+                                 double *const *x, const lub_pcg_options *o, lub_solve_result *res)
+{
+    if (!s->ready || s->As != A || s->stamp != A->stamp)
+        lub_bug("lub_petsc_solve without a set-up of this matrix");
+    lub_solve_status worst = LUB_SOLVE_OK;
+    if (KSPSetTolerances(s->ksp, o->tolerance, 0.0, PETSC_DEFAULT, o->max_iter) ||
+        KSPSetInitialGuessNonzero(s->ksp, o->warm_start ? PETSC_TRUE : PETSC_FALSE))
+        lub_fatal_run("PETSc: KSPSetTolerances failed");
+    for (int k = 0; k < nrhs; k++) {
+        lub_solve_result *r = &res[k];
+        memset(r, 0, sizeof *r);
+        r->column = -1;
+        double bn = 0.0;
+        for (int i = 0; i < A->n; i++) bn += b[k][i] * b[k][i];
+        bn = sqrt(bn);
+        if (!isfinite(bn)) {
+            r->status = LUB_SOLVE_NONFINITE;
+        } else if (bn == 0.0) {
+            memset(x[k], 0, (size_t)A->n * sizeof *x[k]);
+            r->status = LUB_SOLVE_OK;
+        } else {
+            KSPConvergedReason why = KSP_CONVERGED_ITERATING;
+            PetscInt its = 0;
+            if (o->warm_start) {
+                lub_csr_spmv(A, x[k], s->r);
+                double r0 = 0.0;
+                for (int i = 0; i < A->n; i++) r0 += (b[k][i] - s->r[i]) * (b[k][i] - s->r[i]);
+                r->residual0 = sqrt(r0) / bn;
+            } else {
+                r->residual0 = 1.0;
+            }
+            /* the caller's arrays in PETSc's vectors, no copy */
+            if (VecPlaceArray(s->b, b[k]) || VecPlaceArray(s->x, x[k]) ||
+                KSPSolve(s->ksp, s->b, s->x) || KSPGetConvergedReason(s->ksp, &why) ||
+                KSPGetIterationNumber(s->ksp, &its) || VecResetArray(s->b) || VecResetArray(s->x))
+                why = KSP_DIVERGED_PC_FAILED;
+            r->iterations = (int)its;
+            r->status = reason_status(why);
+            /* the true residual, as the other solvers report it */
+            lub_csr_spmv(A, x[k], s->r);
+            double rn = 0.0;
+            for (int i = 0; i < A->n; i++) rn += (b[k][i] - s->r[i]) * (b[k][i] - s->r[i]);
+            r->residual = sqrt(rn) / bn;
+            if (r->status == LUB_SOLVE_OK && !isfinite(r->residual))
+                r->status = LUB_SOLVE_NONFINITE;
+        }
+        r->converged = r->status == LUB_SOLVE_OK;
+        if (r->status > worst) worst = r->status;
+    }
+    return worst;
+}
+
+#endif
