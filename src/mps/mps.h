@@ -98,9 +98,12 @@ typedef struct {
     int gravity;   /* a uniform body acceleration g given with the configuration (callers */
     double g[3];   /* without models; the models of a scene add theirs: hooks.forces) */
     int viscosity; /* LUB_VISCOSITY_* */
-    double patch_velocity[LUB_MAX_PATCHES][3]; /* wall velocities (movingWalls) */
+    double patch_velocity[LUB_MAX_PATCHES][3]; /* wall velocities (movingWalls); on a patch
+                                                  a model moves: a velocity of its largest
+                                                  speed (lubFoam's Courant number), or 0 */
     int patch_moved[LUB_MAX_PATCHES]; /* 1: a model sets the velocity of the patch's wall and
-                                         dummy particles before each step (elasticWall) */
+                                         dummy particles before each step (elasticWall, a
+                                         movingWalls motion history) */
 
     /* set by a model that drives the solvers (multiResolution), not read from a dictionary */
     int fixed_flags; /* allocate lub_mps.fixed: particles whose velocity and pressure are given */

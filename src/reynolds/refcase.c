@@ -127,7 +127,8 @@ void lub_refcase_read(lub_refcase *rc, const lub_case *c)
     lub_models_declare(lub_dict_root(md));
     rc->vel = lub_malloc((size_t)rc->g.nwalls * sizeof *rc->vel);
     rc->moving = lub_malloc((size_t)rc->g.nwalls * sizeof *rc->moving);
-    lub_moving_walls_read(lub_dict_root(md), &rc->g, rc->vel, rc->moving);
+    rc->motion = lub_malloc((size_t)rc->g.nwalls * sizeof *rc->motion);
+    lub_moving_walls_read(lub_dict_root(md), &rc->g, rc->motion, rc->moving);
     lub_refcase_move(rc, 0.0, NULL);
     int elastic = lub_elastic_wall_read(lub_dict_root(md), &rc->g, &rc->ew);
     lub_dict_finish(md);
@@ -164,6 +165,12 @@ void lub_refcase_read(lub_refcase *rc, const lub_case *c)
     /* a steady gap: the cylinder at rest, the lower wall sliding along itself */
     const double *vl = rc->vel[rc->wl], *vu = rc->vel[rc->wu];
     int flat = rc->lower->type == LUB_WALL_PLANE && fabs(rc->lower->normal[0]) < 1e-12;
+    if (rc->ehl && (lub_wall_motion_is_history(&rc->motion[rc->wl]) ||
+                    lub_wall_motion_is_history(&rc->motion[rc->wu])))
+        lub_node_error(rc->ew.node,
+                       "soft EHL is steady: the walls '%s' and '%s' must move at constant "
+                       "velocities (constant/models.yaml movingWalls gives a motion history)",
+                       s->lower, s->upper);
     if (rc->ehl && (vu[0] != 0.0 || vu[1] != 0.0 || vl[1] != 0.0 || (vl[0] != 0.0 && !flat)))
         lub_node_error(rc->ew.node,
                        "soft EHL is steady: the elastic cylinder '%s' must be at rest and the "
@@ -175,18 +182,24 @@ void lub_refcase_read(lub_refcase *rc, const lub_case *c)
     rc->ew.node = rc->ew.patch_node = rc->ew.ramp_node = NULL; /* freed with md */
 }
 
-/* Wall w0 moving at v, translated to time t into w (w->pts its own array). */
-static void wall_at(lub_wall *w, const lub_wall *w0, const double *v, double t)
+/* Wall w0 with motion mo, translated to time t into w (w->pts its own array). */
+static void wall_at(lub_wall *w, const lub_wall *w0, const lub_wall_motion *mo, double t)
 {
-    double d[3] = {v[0] * t, v[1] * t, v[2] * t};
+    double d[3];
+    lub_wall_motion_displacement(mo, t, d);
     lub_wall_translate(w, w0, d);
 }
 
 void lub_refcase_move(lub_refcase *rc, double t, const lub_node *node)
 {
     if (!(t >= 0.0) || !isfinite(t)) lub_bug("lub_refcase_move: t = %g", t);
-    wall_at(&rc->wt[0], &rc->g.walls[rc->wl], rc->vel[rc->wl], t);
-    wall_at(&rc->wt[1], &rc->g.walls[rc->wu], rc->vel[rc->wu], t);
+    wall_at(&rc->wt[0], &rc->g.walls[rc->wl], &rc->motion[rc->wl], t);
+    wall_at(&rc->wt[1], &rc->g.walls[rc->wu], &rc->motion[rc->wu], t);
+    for (int w = 0; w < rc->g.nwalls; w++) lub_wall_motion_velocity(&rc->motion[w], t, rc->vel[w]);
+    lub_wall_motion_displacement(&rc->motion[rc->wl], t, rc->disp[0]);
+    lub_wall_motion_displacement(&rc->motion[rc->wu], t, rc->disp[1]);
+    rc->u1 = rc->vel[rc->wl][0];
+    rc->u2 = rc->vel[rc->wu][0];
     rc->t = t;
     rc->t_node = node;
 }
@@ -197,6 +210,8 @@ void lub_refcase_free(lub_refcase *rc)
     free(rc->wt[1].pts);
     free(rc->vel);
     free(rc->moving);
+    if (rc->motion) lub_moving_walls_free(rc->motion, rc->g.nwalls);
+    free(rc->motion);
     lub_dict_free(rc->s.dict);
     lub_geometry_free(&rc->g);
     memset(rc, 0, sizeof *rc);
@@ -206,11 +221,11 @@ void lub_refcase_free(lub_refcase *rc)
  * which wall w has moved, else "". */
 static const char *moved_note(const lub_refcase *rc, const lub_wall *w, char *buf, size_t size)
 {
-    const double *v = rc->vel[w == rc->lower ? rc->wl : rc->wu];
+    const double *v = rc->disp[w == rc->lower ? 0 : 1];
     buf[0] = '\0';
     if (rc->t > 0.0 && (v[0] != 0.0 || v[1] != 0.0 || v[2] != 0.0))
         snprintf(buf, size, " at t = %g s (moved by (%g, %g) m from system/particleGenDict.yaml)",
-                 rc->t, v[0] * rc->t, v[1] * rc->t);
+                 rc->t, v[0], v[1]);
     return buf;
 }
 
@@ -248,7 +263,7 @@ static double min_gap_at(const lub_refcase *rc, double t, int n)
     for (int k = 0; k < 2; k++) {
         const lub_wall *w0 = &rc->g.walls[k ? rc->wu : rc->wl];
         w[k].pts = w0->npts ? lub_malloc(2 * (size_t)w0->npts * sizeof *w0->pts) : NULL;
-        wall_at(&w[k], w0, rc->vel[k ? rc->wu : rc->wl], t);
+        wall_at(&w[k], w0, &rc->motion[k ? rc->wu : rc->wl], t);
     }
     for (int i = 0; i <= 2 * n && !isnan(m); i++) {
         double x = s->inlet + 0.5 * i * (s->outlet - s->inlet) / n, yl, yu;
@@ -275,7 +290,19 @@ _Noreturn static void gap_closed(const lub_refcase *rc, double x, double gap)
                        "the gap between '%s' and '%s' is %s at x = %.9g: it must be > 0 on "
                        "[inlet, outlet] = [%g, %g]",
                        s->lower, s->upper, what, x, s->inlet, s->outlet);
+    /* the first closed time: samples of [0, t] with the motions' turning points (a motion
+     * history may close and open the gap again), then bisection after the last open one */
+    const int ns = 400;
+    double tk[400 + 2 * 64 + 1];
+    int nk = 0;
+    for (int k = 1; k <= ns; k++) tk[nk++] = rc->t * k / ns;
+    nk += lub_wall_motion_breaks(&rc->motion[rc->wl], 0.0, rc->t, tk + nk, 64);
+    nk += lub_wall_motion_breaks(&rc->motion[rc->wu], 0.0, rc->t, tk + nk, 64);
     double ta = 0.0, tb = rc->t;
+    for (int k = 0; k < nk; k++) /* the earliest closed sample */
+        if (tk[k] < tb && !(min_gap_at(rc, tk[k], (int)s->cells) > 0.0)) tb = tk[k];
+    for (int k = 0; k < nk; k++) /* the latest open sample before it */
+        if (tk[k] < tb && tk[k] > ta) ta = tk[k];
     for (int it = 0; it < 200 && tb - ta > 1e-12 * rc->t; it++) {
         double tm = 0.5 * (ta + tb), gm = min_gap_at(rc, tm, (int)s->cells);
         if (gm > 0.0)
@@ -283,13 +310,14 @@ _Noreturn static void gap_closed(const lub_refcase *rc, double x, double gap)
         else
             tb = tm;
     }
-    const double *vl = rc->vel[rc->wl], *vu = rc->vel[rc->wu];
-    char msg[1024];
+    char ml[200], mu[200], msg[1024];
+    lub_wall_motion_describe(&rc->motion[rc->wl], rc->g.dim, ml, sizeof ml);
+    lub_wall_motion_describe(&rc->motion[rc->wu], rc->g.dim, mu, sizeof mu);
     snprintf(msg, sizeof msg,
-             "at t = %g s the gap between '%s' and '%s' is %s at x = %.9g m: the walls, moving "
-             "at (%g, %g) and (%g, %g) m/s (constant/models.yaml movingWalls), close the gap "
+             "at t = %g s the gap between '%s' and '%s' is %s at x = %.9g m: the walls (lower: "
+             "%s, upper: %s; constant/models.yaml movingWalls) close the gap "
              "(%.6g m at t = 0) at t = %.6g s; a reference needs t below that",
-             rc->t, s->lower, s->upper, what, x, vl[0], vl[1], vu[0], vu[1], g0, tb);
+             rc->t, s->lower, s->upper, what, x, ml, mu, g0, tb);
     if (rc->t_node) lub_node_error(rc->t_node, "%s", msg);
     lub_fatal("%s", msg);
 }

@@ -30,6 +30,7 @@
 #include "io/case.h"
 #include "io/dict.h"
 #include "models/elastic.h"
+#include "models/models.h"
 #include "reynolds/reynolds.h"
 
 /* softEHL.mode: auto (soft EHL exactly when constant/models.yaml has elasticWall), on
@@ -72,9 +73,11 @@ typedef struct {
     double t;                      /* the time of lower and upper (lub_refcase_move) */
     const lub_node *t_node;        /* the entry t came from, or NULL (the -time option) */
     double rho, nu, mu;            /* oil; mu = rho nu */
-    double (*vel)[3];              /* velocity of every wall of g (movingWalls) */
+    lub_wall_motion *motion;       /* the motion of every wall of g (movingWalls) */
+    double (*vel)[3];              /* velocity of every wall of g at time t */
+    double disp[2][3];             /* displacement of the lower and upper wall at time t */
     int *moving;                   /* 1 when the wall is listed in movingWalls */
-    double u1, u2;                 /* x-velocities of the lower and upper wall */
+    double u1, u2;                 /* x-velocities of the lower and upper wall at time t */
     int ehl;                       /* soft EHL: the elasticWall model ew is the upper wall */
     lub_elastic_wall ew;           /* constant/models.yaml elasticWall (read when present) */
 } lub_refcase;
@@ -85,9 +88,10 @@ void lub_refcase_read(lub_refcase *rc, const lub_case *c);
 void lub_refcase_free(lub_refcase *rc);
 
 /* The lower and upper wall at time t >= 0: each rigid wall translated from its place in
- * system/particleGenDict.yaml (t = 0) by its movingWalls velocity times t, as lubFoam moves
- * the particles of a moving patch (a periodic domain's wrap is not applied: a wall that has
- * left [inlet, outlet] is an error when the gap is sampled).  A wall sliding along itself
+ * system/particleGenDict.yaml (t = 0) by its movingWalls displacement d(t) (V t, or the
+ * motion history's: models/models.h), the walls' velocities those of t (vel, u1, u2), as
+ * lubFoam moves the particles of a moving patch (a periodic domain's wrap is not applied: a wall
+ * that has left [inlet, outlet] is an error when the gap is sampled).  A wall sliding along itself
  * (the rigid wedge's plane) keeps its surface, so that the gap, and the reference, do not
  * change with t.  node: the dictionary entry t came from, named by the errors of
  * lub_refgap_sample at that time (NULL: it came from the command line). */

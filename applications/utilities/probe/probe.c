@@ -38,11 +38,15 @@ static const char *description =
     "  line [-field LIST] [-from X0 -to X1] [-bin DX]\n"
     "      the fluid particles binned by x: per bin the mean over the film thickness of each\n"
     "      field and the count n of samples: '# x p n'.\n"
-    "  points -at 'x y; x y ...' [-field LIST]\n"
+    "  points -at 'x y; x y ...' [-field LIST] [-history]\n"
     "      kernel-weighted (Shepard) mean at each point over the fluid and wall particles\n"
     "      within the effective radius re (of the level of the nearest particle), with the\n"
     "      MPS weight w(r) = (r/re - 1)^2 (T-6): sum w f / sum w.  '# x y p n' (n: particles\n"
     "      used).  A point with no particle within re is left out with a warning.\n"
+    "      -history: one point, one row per time folder: '# t p n', the pressure history\n"
+    "      at the point (e.g. the film centre of a squeeze film, beside reynoldsRef -series:\n"
+    "      postErr -x t -yref pc history.dat postProcessing/reynoldsRef/0/pc.dat); a time\n"
+    "      with no particle within re gives a row of nan and a warning.\n"
     "  film [-from X0 -to X1] [-bin DX]\n"
     "      the oil film per bin of x: '# x h surface bottom contact n filled full' (with\n"
     "      -dimensionless, X H after n).  Each bin is judged on its particles and, where it\n"
@@ -155,14 +159,15 @@ static const char *description =
     "-at point list or -average window, and bad dictionaries (file:line).";
 
 /* Which options each subcommand takes. */
-enum { O_PATCH, O_FIELD, O_FROM, O_TO, O_BIN, O_ARC, O_AT, O_DIMLESS, O_FACING, O_N };
-static const char *const opt_names[O_N] = {"-patch", "-field", "-from",          "-to",    "-bin",
-                                           "-arc",   "-at",    "-dimensionless", "-facing"};
+enum { O_PATCH, O_FIELD, O_FROM, O_TO, O_BIN, O_ARC, O_AT, O_DIMLESS, O_FACING, O_HISTORY, O_N };
+static const char *const opt_names[O_N] = {"-patch",  "-field",  "-from", "-to",
+                                           "-bin",    "-arc",    "-at",   "-dimensionless",
+                                           "-facing", "-history"};
 static const int applies[PROBE_NKINDS][O_N] = {
-    [PROBE_WALL] = {1, 1, 1, 1, 1, 1, 0, 1, 1},   [PROBE_LINE] = {0, 1, 1, 1, 1, 0, 0, 1, 0},
-    [PROBE_POINTS] = {0, 1, 0, 0, 0, 0, 1, 1, 0}, [PROBE_FILM] = {0, 0, 1, 1, 1, 0, 0, 1, 0},
-    [PROBE_TOTALS] = {1, 0, 0, 0, 0, 0, 0, 0, 0}, [PROBE_SHAPE] = {1, 0, 1, 1, 0, 0, 0, 1, 0},
-    [PROBE_FRONT] = {0, 0, 0, 0, 0, 0, 0, 0, 0},
+    [PROBE_WALL] = {1, 1, 1, 1, 1, 1, 0, 1, 1, 0},   [PROBE_LINE] = {0, 1, 1, 1, 1, 0, 0, 1, 0, 0},
+    [PROBE_POINTS] = {0, 1, 0, 0, 0, 0, 1, 1, 0, 1}, [PROBE_FILM] = {0, 0, 1, 1, 1, 0, 0, 1, 0, 0},
+    [PROBE_TOTALS] = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0}, [PROBE_SHAPE] = {1, 0, 1, 1, 0, 0, 0, 1, 0, 0},
+    [PROBE_FRONT] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0},
 };
 
 static const char *in_case(const lub_case *c, const char *path, char *buf)
@@ -189,7 +194,7 @@ int main(int argc, char **argv)
     static const char *patch = NULL, *field = NULL, *at = NULL, *average = NULL, *out = NULL,
                       *facing = NULL;
     static double from = NAN, to = NAN, bin = NAN;
-    static int arc = 0, dimensionless = 0;
+    static int arc = 0, dimensionless = 0, history = 0;
     static lub_strlist set_names = {0};
     lub_option opts[] = {
         {"-patch", "NAME", "wallPressure, wallShape: the wall patch; totals: add its load",
@@ -205,6 +210,8 @@ int main(int argc, char **argv)
          "(upper) face",
          LUB_OPT_STR, &facing},
         {"-at", "'x y; x y'", "points: where to sample", LUB_OPT_STR, &at},
+        {"-history", NULL, "points: one point, one row per time: '# t p n'", LUB_OPT_FLAG,
+         &history},
         {"-average", "T0:T1", "average over the selected times in [T0, T1]", LUB_OPT_STR, &average},
         {"-dimensionless", NULL, "add X (S), P, H columns (thesis T-38, T-39)", LUB_OPT_FLAG,
          &dimensionless},
@@ -249,8 +256,8 @@ int main(int argc, char **argv)
         else
             lub_fatal("-facing '%s': expected down or up", facing);
     }
-    int given[O_N] = {patch != NULL, field != NULL, !isnan(from),  !isnan(to),    !isnan(bin),
-                      arc,           at != NULL,    dimensionless, facing != NULL};
+    int given[O_N] = {patch != NULL, field != NULL, !isnan(from),  !isnan(to),     !isnan(bin),
+                      arc,           at != NULL,    dimensionless, facing != NULL, history};
 
     probe_ctx x;
     memset(&x, 0, sizeof x);
@@ -285,6 +292,7 @@ int main(int argc, char **argv)
         s.arc = arc;
         s.facing = facing_dir;
         s.dimensionless = dimensionless;
+        s.history = history;
         if (average) s.average = 1, s.t0 = t0, s.t1 = t1;
         char err[512];
         if (at && probe_parse_points(&s, at, err, sizeof err)) {

@@ -44,11 +44,12 @@ typedef struct {
     double *pts; /* points: npts x 3 (z = 0 in 2-D), owned */
     size_t npts;
     int pts_dim; /* coordinates given per point */
+    int history; /* points: one point, one row per time '# t p n' */
     int average; /* average over [t0, t1] */
     double t0, t1;
     int dimensionless;
     /* where each setting came from, for messages: a dictionary entry, or NULL for options */
-    const lub_node *node, *patch_node, *field_node, *at_node, *average_node;
+    const lub_node *node, *patch_node, *field_node, *at_node, *average_node, *history_node;
 } probe_spec;
 
 void probe_spec_init(probe_spec *s, probe_kind kind, const char *name);

@@ -215,7 +215,11 @@ static void read_set(probe_spec *s, const char *name, lub_node *m)
             lub_node_error(lub_dict_get(m, "to"), "'to' (%g) must be greater than 'from' (%g)",
                            s->to, s->from);
     }
-    if (kind == PROBE_POINTS) read_points(s, m);
+    if (kind == PROBE_POINTS) {
+        read_points(s, m);
+        s->history_node = lub_dict_find(m, "history");
+        s->history = lub_dict_bool_or(m, "history", 0);
+    }
     lub_node *av = lub_dict_find(m, "average");
     if (av) {
         double w[2];

@@ -586,9 +586,62 @@ static void run_wall_particles(job *j)
 
 /* ---- points: kernel-weighted means at given points ------------------------------------ */
 
+/* points -history: one point, a row '# t <fields> n' per time, one table under the first
+ * time (as the other time series: totals, front) */
+static void run_point_history(job *j)
+{
+    const probe_spec *s = j->s;
+    if (s->npts != 1)
+        probe_error(s->history_node ? s->history_node : s->at_node,
+                    "%shistory samples one point, but %zu are given", s->history_node ? "" : "-",
+                    s->npts);
+    if (s->average)
+        probe_error(s->average_node,
+                    "%saverage does not apply to a history (one row per time): leave it out",
+                    s->average_node ? "" : "-");
+    if (j->sc)
+        probe_error(s->node, "%sdimensionless does not apply to a history", s->node ? "" : "-");
+    for (size_t it = 0; it < j->nt; it++) {
+        job_read(j, it);
+        if (it == 0) {
+            job_fields(j);
+            if (s->pts_dim != j->P.dim)
+                probe_error(s->at_node, "%sthe point has %d coordinates, but the case is %d-D (%s)",
+                            s->at_node ? "" : "-at: ", s->pts_dim, j->P.dim, j->file);
+            char h[2048] = "";
+            header_add(h, sizeof h, "t[s]");
+            for (int c = 0; c < j->f.n; c++) header_add(h, sizeof h, j->f.col[c].column);
+            header_add(h, sizeof h, "n");
+            probe_block_begin(&j->b, h, j->f.n + 2);
+            const double *p = s->pts;
+            if (j->P.dim == 3)
+                probe_block_comment(&j->b, "at (%.9g, %.9g, %.9g): the Shepard mean over re", p[0],
+                                    p[1], p[2]);
+            else
+                probe_block_comment(&j->b, "at (%.9g, %.9g): the Shepard mean over re", p[0], p[1]);
+        }
+        job_arrays(j);
+        double out[LUB_POST_MAX_COLS + 1], row[LUB_POST_MAX_COLS + 2], re = 0.0;
+        size_t used = lub_sample_point(&j->P, s->pts, j->vals, j->f.n, out, &re);
+        row[0] = j->times[it].value;
+        for (int c = 0; c < j->f.n; c++) row[1 + c] = used ? out[c] : NAN;
+        row[1 + j->f.n] = (double)used;
+        if (!used)
+            lub_warning("time %s: no fluid or wall particle within re = %g of the point: nan",
+                        j->times[it].name, re);
+        probe_block_row(&j->b, row);
+        lub_particles_free(&j->P);
+    }
+    probe_sink_write(j->k, &j->b, j->times[0].name, j->times[0].value);
+}
+
 static void run_points(job *j)
 {
     const probe_spec *s = j->s;
+    if (s->history) {
+        run_point_history(j);
+        return;
+    }
     lub_accum acc = {0};
     int dim = 0;
     for (size_t it = 0; it < j->nt; it++) {
@@ -1094,7 +1147,7 @@ void probe_run(probe_ctx *x, probe_spec *s, probe_sink *k)
         probe_error(s->node, "-dimensionless does not apply to %s", probe_kind_names[s->kind]);
     job_times(&j);
     k->tcol = !k->per_time && j.nt > 1 && !s->average && s->kind != PROBE_TOTALS &&
-              s->kind != PROBE_FRONT;
+              s->kind != PROBE_FRONT && !s->history;
     if (s->dimensionless) j.sc = ctx_scales(x);
     switch (s->kind) {
     case PROBE_WALL:

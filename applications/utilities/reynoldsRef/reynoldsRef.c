@@ -61,13 +61,15 @@ void reynoldsRef_table_write(const lub_case *c, const char *out_file, const char
 /* The report's line on the time of the walls: what moving them to t did to the gap. */
 static void report_time(const lub_refcase *rc, const lub_refgap *G)
 {
-    const double *vl = rc->vel[rc->wl], *vu = rc->vel[rc->wu];
+    const double *dl = rc->disp[0], *du = rc->disp[1];
+    const int history = lub_wall_motion_is_history(&rc->motion[rc->wl]) ||
+                        lub_wall_motion_is_history(&rc->motion[rc->wu]);
     if (rc->t == 0.0)
         lub_message("at t        0 s (the walls of system/particleGenDict.yaml)");
-    else if (G->moving_shape)
-        lub_message("at t        %g s: the walls moved by their velocities, lower by (%g, %g) m, "
+    else if (G->moving_shape || history)
+        lub_message("at t        %g s: the walls moved by their %s, lower by (%g, %g) m, "
                     "upper by (%g, %g) m",
-                    rc->t, vl[0] * rc->t, vl[1] * rc->t, vu[0] * rc->t, vu[1] * rc->t);
+                    rc->t, history ? "motions" : "velocities", dl[0], dl[1], du[0], du[1]);
     else
         lub_message("at t        %g s (names the output; the gap does not change with time: "
                     "no wall moves across the film)",
@@ -240,11 +242,117 @@ static void reference2d(const lub_case *c, const lub_refcase *rc, const lub_refg
     free(mid);
 }
 
+/* The nodal table p of G's grid at x (linear between nodes). */
+static double at_x(const lub_refgap *G, const double *v, double x)
+{
+    double f = (x - G->xa) / G->dx;
+    int i = (int)floor(f);
+    if (i < 0) return v[0];
+    if (i >= G->n) return v[G->n];
+    f -= i;
+    return (1.0 - f) * v[i] + f * v[i + 1];
+}
+
+/* -series: the reference at every time of times[0..nt), one row each of
+ * postProcessing/reynoldsRef/<first time>/pc.dat (or out_file): '# t pc load h', pc and h at
+ * x = xc. */
+static void series(const lub_case *c, lub_refcase *rc, const lub_time *times, size_t nt, double xc,
+                   int given_x, const char *out_file, double t_start)
+{
+    const lub_refcase_settings *s = &rc->s;
+    if (rc->ehl)
+        lub_fatal("-series: the soft-EHL reference is steady (constant/models.yaml "
+                  "elasticWall): a time series needs the rigid reference (softEHL: {mode: off} "
+                  "in system/reynoldsRefDict.yaml)");
+    if (s->width > 0.0)
+        lub_fatal("-series: the time series is of the 1-D reference (the infinitely wide "
+                  "film); system/reynoldsRefDict.yaml gives a finite width %g m: leave out "
+                  "'width' for the series, or run reynoldsRef -time LIST for the finite width's "
+                  "p2d.dat at each time",
+                  s->width);
+    if (!(xc >= s->inlet && xc <= s->outlet))
+        lub_fatal("-at %g: the point must lie in [inlet, outlet] = [%g, %g] of "
+                  "system/reynoldsRefDict.yaml",
+                  xc, s->inlet, s->outlet);
+    char path[LUB_PATH_MAX];
+    lub_output o;
+    if (out_file) {
+        lub_output_open(&o, out_file);
+    } else {
+        lub_postproc_path(c, "reynoldsRef", times[0].name, "pc.dat", path);
+        lub_output_open(&o, path);
+    }
+    lub_table_write_header(o.fp, "t[s] pc[Pa] load[N/m] h[m]");
+    fprintf(o.fp, "# pc, h at x = %.9g m (%s); %s condition; %ld cells on [%g, %g] m\n", xc,
+            given_x ? "-at" : "the film centre, midway between inlet and outlet",
+            lub_reynolds_bc_names[s->bc], s->cells, s->inlet, s->outlet);
+    double pmin = INFINITY, pmax = -INFINITY, tmin = 0, tmax = 0, t_solve = 0;
+    for (size_t k = 0; k < nt; k++) {
+        lub_refcase_move(rc, times[k].value, NULL);
+        lub_refgap G;
+        lub_refgap_sample(&G, rc);
+        double *p = lub_malloc((size_t)(G.n + 1) * sizeof *p);
+        lub_reynolds_result res;
+        double t0 = lub_wtime();
+        lub_reynolds_status st = lub_refcase_solve(rc, &G, p, &res);
+        t_solve += lub_wtime() - t0;
+        if (st != LUB_REYNOLDS_OK)
+            lub_fatal_run("the Reynolds solve failed: %s (%d cells on [%g, %g], %s, t = %g s)",
+                          lub_reynolds_status_string(st), G.n, G.xa, G.xb,
+                          lub_reynolds_bc_names[s->bc], rc->t);
+        double row[4] = {times[k].value, at_x(&G, p, xc), res.load, at_x(&G, G.h, xc)};
+        lub_table_write_row(o.fp, row, 4);
+        if (row[1] < pmin) pmin = row[1], tmin = row[0];
+        if (row[1] > pmax) pmax = row[1], tmax = row[0];
+        free(p);
+        lub_refgap_free(&G);
+    }
+    lub_output_close(&o);
+    lub_message("series      %zu times, t = %s .. %s s", nt, times[0].name, times[nt - 1].name);
+    lub_message("point       x = %.6g m%s", xc, given_x ? "" : " (the film centre)");
+    char ml[200], mu[200];
+    lub_wall_motion_describe(&rc->motion[rc->wl], rc->g.dim, ml, sizeof ml);
+    lub_wall_motion_describe(&rc->motion[rc->wu], rc->g.dim, mu, sizeof mu);
+    lub_message("walls       lower '%s' %s, upper '%s' %s", s->lower, ml, s->upper, mu);
+    lub_message("oil         rho = %g kg/m^3, nu = %g m^2/s, mu = %g Pa s", rc->rho, rc->nu,
+                rc->mu);
+    lub_message("condition   %s", lub_reynolds_bc_names[s->bc]);
+    lub_message("pc          max %.6g Pa at t = %g s, min %.6g Pa at t = %g s", pmax, tmax, pmin,
+                tmin);
+    if (out_file)
+        lub_message("written     %s", o.path);
+    else
+        lub_message("written     postProcessing/reynoldsRef/%s/pc.dat", times[0].name);
+    lub_message("time        solve %.3g s, total %.3g s", t_solve, lub_wtime() - t_start);
+}
+
+/* "T0:T1:N": N + 1 times from T0 to T1 (N >= 1, 0 <= T0 < T1) */
+static size_t parse_grid(const char *text, int precision, lub_time **times)
+{
+    double t0, t1;
+    long n;
+    char tail;
+    if (sscanf(text, "%lf:%lf:%ld%c", &t0, &t1, &n, &tail) != 3 || !(t0 >= 0) || !(t1 > t0) ||
+        n < 1 || n > 10000000)
+        lub_fatal("-grid '%s': expected T0:T1:N, N + 1 times from T0 >= 0 to T1 > T0 (N >= 1), "
+                  "e.g. -grid 0:1:200",
+                  text);
+    *times = lub_malloc((size_t)(n + 1) * sizeof **times);
+    for (long k = 0; k <= n; k++) {
+        double t = k == n ? t1 : t0 + (t1 - t0) * (double)k / (double)n;
+        (*times)[k].value = t;
+        lub_time_name(t, precision, (*times)[k].name, sizeof(*times)[k].name);
+    }
+    return (size_t)n + 1;
+}
+
 int main(int argc, char **argv)
 {
     static int dimensionless = 0;
     static const char *out_file = NULL;
-    static double inlet = NAN;
+    static double inlet = NAN, at = NAN;
+    static int series_flag = 0;
+    static const char *grid = NULL;
     lub_option opts[] = {
         {"-dimensionless", NULL,
          "add the thesis' X = x/sqrt(R h0), P (T-38, T-39), H = h/h0; soft EHL: X = x/b, "
@@ -258,6 +366,16 @@ int main(int argc, char **argv)
          "the inlet x instead of 'inlet' of system/reynoldsRefDict.yaml (e.g. the inlet "
          "meniscus of an MPS run: probe film)",
          LUB_OPT_REAL, &inlet},
+        {"-series", NULL,
+         "a time series: '# t pc load h' at every selected time folder (or -grid) in "
+         "postProcessing/reynoldsRef/<first time>/pc.dat",
+         LUB_OPT_FLAG, &series_flag},
+        {"-grid", "T0:T1:N", "-series: N + 1 times from T0 to T1 instead of the time folders",
+         LUB_OPT_STR, &grid},
+        {"-at", "X",
+         "-series: pc and h at x = X (default: the film centre, midway between "
+         "inlet and outlet)",
+         LUB_OPT_REAL, &at},
         {0}};
     lub_program_info info = {
         .name = "reynoldsRef",
@@ -282,6 +400,15 @@ int main(int argc, char **argv)
             "for every time a squeeze run wrote there).  Walls sliding along themselves\n"
             "(a rigid wedge's plane) leave the gap as it is: t then only names the output.\n"
             "A gap that has closed by t is an error giving the time the walls touch.\n"
+            "Motion histories (movingWalls motion: sinusoidal or table): the walls at t are\n"
+            "displaced by d(t) and dh/dt comes from their velocities d'(t) at t.\n"
+            "Series (-series): the reference at every time folder selected (every one\n"
+            "without -time, -latestTime, -noZero) or at the times of -grid T0:T1:N, one row\n"
+            "per time of postProcessing/reynoldsRef/<first time>/pc.dat: '# t pc load h',\n"
+            "pc the pressure and h the gap at the film centre (midway between inlet and\n"
+            "outlet) or at -at X, load the integral of p (methods.md §5.5 (c): the squeeze\n"
+            "film's p_c(t)).  With boundaryCondition reynolds the film carries no tension\n"
+            "(p >= 0: 0 while the walls open), with fullSommerfeld it does.\n"
             "Soft EHL (constant/models.yaml elasticWall, softEHL in reynoldsRefDict.yaml):\n"
             "the upper wall is an elastic cylinder carrying the load W; the gap\n"
             "h = h0 + x^2/(2R) + v(x), v from the half-space influence coefficients (thesis\n"
@@ -331,6 +458,34 @@ int main(int argc, char **argv)
     lub_time *times;
     size_t nt = 1;
     int from_folders = a.time || a.latest_time || a.no_zero;
+    if ((grid || isfinite(at)) && !series_flag)
+        lub_fatal("%s belongs to -series (a time series of the film-centre pressure)",
+                  grid ? "-grid" : "-at");
+    if (series_flag) {
+        if (grid && from_folders)
+            lub_fatal("-series: give either -grid or a time folder selection (-time, "
+                      "-latestTime, -noZero), not both");
+        if (grid) {
+            int precision = 6;
+            lub_dict *cd =
+                lub_dict_read_optional(lub_case_path(&c, path, "system/controlDict.yaml"));
+            if (cd) {
+                precision = (int)lub_dict_int_or(lub_dict_root(cd), "timePrecision", 6, 1, 17);
+                lub_dict_free(cd);
+            }
+            nt = parse_grid(grid, precision, &times);
+        } else {
+            nt = lub_case_select_times(&c, a.time, a.latest_time, a.no_zero, &times);
+        }
+        for (size_t k = 0; k < nt; k++)
+            if (!(times[k].value >= 0.0))
+                lub_fatal("time folder '%s': the reference needs a time >= 0", times[k].name);
+        series(&c, &rc, times, nt, isfinite(at) ? at : 0.5 * (s->inlet + s->outlet), isfinite(at),
+               out_file, t_start);
+        free(times);
+        lub_refcase_free(&rc);
+        return 0;
+    }
     if (from_folders) {
         nt = lub_case_select_times(&c, a.time, a.latest_time, a.no_zero, &times);
     } else {
