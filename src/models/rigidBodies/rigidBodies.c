@@ -36,6 +36,16 @@
  * V, omega, the fluid's F and T of the last step, the contacts' tangential springs) is its
  * entry of uniform/state.yaml (%.17g): a restart repeats the uninterrupted run exactly.
  *
+ * What the MPS step assumes of wall particles, and how a body meets it: they move in step 3
+ * with their velocity and are not corrected (mps.h patch_moved keeps the velocity given here);
+ * the neighbour lists follow them (kept while no particle moved more than half the skin since
+ * the build, the snap after the step included, which is round-off); a wall particle of the
+ * body above the free surface takes the open-side test with its dummies behind it (step.c
+ * free_surface) and gets p = 0 there, which the surface integral then counts as nothing;
+ * lub_mps_check's test of a fluid particle through a wall takes the positions before the step
+ * as r - u dt, which the chord velocity makes exact for the body's particles.  The
+ * multi-resolution driver's still walls are refused (check).
+ *
  * One resolution level only; a body must not cross a periodic side (its particles would be
  * wrapped apart).  Light bodies (rho_s below about rho_f) make the explicit coupling
  * unstable (added mass, methods.md §7). */
