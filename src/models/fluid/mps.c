@@ -85,8 +85,19 @@ static void mps_log(const lub_mps *m, double dt, double pit, char *buf, size_t s
  * loses.  u*_i is the velocity after the viscous step (the implicit half of T-31; the
  * explicit scheme took u^k, a difference of O(dt)), u_j the body particle's velocity of the
  * step; the weights are those of the lists after the step (r*).  With the LSMPS Laplacian
- * the standard coefficients stand in for the fitted ones. */
-static void mps_wall_forces(const lub_mps *m, int patch, double *const area[3], double *const f[3])
+ * the standard coefficients stand in for the fitted ones.
+ *
+ * The Laplacian form mu lap(u) = div(mu grad u) is the momentum equation of an
+ * incompressible fluid, but the traction its pair terms carry through a surface is
+ * mu (grad u) n, not mu (grad u + grad u^T) n: a rigid rotation, whose stress is zero, would
+ * still pass mu grad(u) n = mu omega x n.  At a wall moving rigidly with the no-slip fluid,
+ * (grad u)^T n is the wall's own, -omega x n (the tangential derivatives of u.n are the
+ * wall's, and incompressibility gives its normal derivative), so each wall particle gets
+ * -mu omega x a_i besides: no force over a closed surface, a torque -2 mu A omega on a 2-D
+ * body of area A (-2 mu V omega in 3-D).  Without it the torque on a cylinder turning in a
+ * fixed one tends to 5/8 of the closed form as l0 -> 0 (methods.md §7.2). */
+static void mps_wall_forces(const lub_mps *m, int patch, double *const area[3],
+                            const double omega[3], double *const f[3])
 {
     const lub_particles *P = m->P;
     const size_t n = P->n;
@@ -97,6 +108,14 @@ static void mps_wall_forces(const lub_mps *m, int patch, double *const area[3], 
             f[d][i] = on && P->kind[i] == LUB_WALL && d < dim ? -P->p[i] * area[d][i] : 0.0;
     }
     if (m->c.viscosity == LUB_VISCOSITY_NONE) return;
+    const double mu = m->c.rho * m->c.nu;
+    for (size_t i = 0; i < n; i++) {
+        if (P->kind[i] != LUB_WALL || P->patch[i] != patch) continue;
+        const double a[3] = {area[0][i], area[1][i], area[2][i]};
+        const double wxa[3] = {omega[1] * a[2] - omega[2] * a[1], omega[2] * a[0] - omega[0] * a[2],
+                               omega[0] * a[1] - omega[1] * a[0]};
+        for (int d = 0; d < dim; d++) f[d][i] -= mu * wxa[d];
+    }
     double dv = m->c.rho;
     for (int d = 0; d < dim; d++) dv *= m->l0;
     const double k = dv * lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, m->c.nu);

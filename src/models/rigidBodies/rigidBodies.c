@@ -443,7 +443,9 @@ static void rigid_after_step(lub_model *m, lub_scene *s, double t)
             area_vector(rb, R, r0, o, f->l0, a);
             for (int d = 0; d < 3; d++) r->area[d][i] = a[d];
         }
-        s->fluid->wall_forces(f, rb->patch, r->area, r->f);
+        double w[3];
+        lub_body_omega_world(&rb->b, &rb->s, w);
+        s->fluid->wall_forces(f, rb->patch, r->area, w, r->f);
         double F[3] = {0, 0, 0}, T[3] = {0, 0, 0};
         for (size_t i = 0; i < P->n; i++) {
             if (P->kind[i] == LUB_FLUID || P->patch[i] != rb->patch) continue;
