@@ -278,10 +278,9 @@ static void fields(lub_particles *P, double *x0[3])
     for (int d = 0; d < P->dim; d++) x0[d] = lub_particles_find_extra(P, offset_field[d]);
 }
 
-static double vec_entry(lub_node *st, const char *key, double *out, int n)
+static void vec_entry(lub_node *st, const char *key, double *out, int n)
 {
     lub_dict_vec(st, key, out, n, n, LUB_ANY);
-    return out[0];
 }
 
 static void rigid_init(lub_model *m, lub_scene *s)
