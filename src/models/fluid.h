@@ -35,6 +35,18 @@ typedef struct lub_fluid_type {
     /* Its part of the log line after the step (dt; pit: the mean pressure iterations per
      * step so far). */
     void (*log)(const lub_mps *m, double dt, double pit, char *buf, size_t size);
+    /* The force the fluid exerted in the step just taken on each particle of patch (wall and
+     * dummy: f[d][i], 0 on the other particles) [N; N/m in 2-D], the reaction of what the
+     * step did to the fluid, so that fluid and body exchange momentum (rigidBodies,
+     * methods.md §7.2).  area[d][i]: the outward area vector (normal into the fluid times
+     * the surface it stands for, m^2; m in 2-D) of each wall particle of the patch, from the
+     * body's shape; omega: the patch's angular velocity (world frame, rad/s; the patch
+     * moves rigidly).  A formulation whose pressure acts through the surface and whose
+     * viscous term is the Laplacian of the velocity components uses them (mps); a
+     * pair-force formulation (MPH: f_i = the sum over fluid j of the pair forces of (K-6),
+     * (K-8)) may ignore them.  NULL: the formulation cannot move bodies. */
+    void (*wall_forces)(const lub_mps *m, int patch, double *const area[3], const double omega[3],
+                        double *const f[3]);
 } lub_fluid_type;
 
 /* The formulations, NULL-terminated, the default first. */

@@ -11,6 +11,7 @@
 #include "core/error.h"
 #include "models/fluid.h"
 #include "models/transport.h"
+#include "mps/operators.h"
 
 static void mps_read(lub_mps_config *c, const lub_case *cs, lub_node *models, lub_node *entry)
 {
@@ -65,6 +66,72 @@ static void mps_log(const lub_mps *m, double dt, double pit, char *buf, size_t s
              m->st.p.residual, pit, vit, m->st.nsurface);
 }
 
+/* The force on the particles of a body's patch (rigidBodies; methods.md §7).
+ *
+ * Pressure: -p_i a_i on each wall particle i, the pressure the step solved there (T-9, T-10)
+ * over the surface a_i it stands for.  Not the reaction of the pressure-gradient terms that
+ * the wall particles put into their fluid neighbours' gradient (T-13, T-14): those are
+ * differences p_j - p_i (or p_j - p_hat_i), blind to the pressure's level, and their sum
+ * over a body scales with its perimeter times rho g re, not with its volume (Archimedes
+ * would fail); nor do MPS's fluid-fluid gradient terms cancel in pairs (the difference form
+ * is symmetric in i, j, not antisymmetric), so the fluid's own momentum is not conserved
+ * either and no reaction could make fluid + body conserve it exactly.  The surface integral
+ * of the wall pressure is what the pressure field exerts on the body's surface.
+ *
+ * Viscosity: the reaction of the Laplacian terms (T-3) between each fluid particle i and
+ * the patch's wall and dummy particles j, rho l0^d nu (2d / (lambda0 n0)) f_j w_ij (u_j -
+ * u*_i), f_j = 2 for a dummy with mirrored velocity (the ghost 2 U - u_i), else 1: the
+ * Laplacian's pair terms are antisymmetric, so the viscous momentum the fluid gains the body
+ * loses.  u*_i is the velocity after the viscous step (the implicit half of T-31; the
+ * explicit scheme took u^k, a difference of O(dt)), u_j the body particle's velocity of the
+ * step; the weights are those of the lists after the step (r*).  With the LSMPS Laplacian
+ * the standard coefficients stand in for the fitted ones.
+ *
+ * The Laplacian form mu lap(u) = div(mu grad u) is the momentum equation of an
+ * incompressible fluid, but the traction its pair terms carry through a surface is
+ * mu (grad u) n, not mu (grad u + grad u^T) n: a rigid rotation, whose stress is zero, would
+ * still pass mu grad(u) n = mu omega x n.  At a wall moving rigidly with the no-slip fluid,
+ * (grad u)^T n is the wall's own, -omega x n (the tangential derivatives of u.n are the
+ * wall's, and incompressibility gives its normal derivative), so each wall particle gets
+ * -mu omega x a_i besides: no force over a closed surface, a torque -2 mu A omega on a 2-D
+ * body of area A (-2 mu V omega in 3-D).  Without it the torque on a cylinder turning in a
+ * fixed one tends to 5/8 of the closed form as l0 -> 0 (methods.md §7.2). */
+static void mps_wall_forces(const lub_mps *m, int patch, double *const area[3],
+                            const double omega[3], double *const f[3])
+{
+    const lub_particles *P = m->P;
+    const size_t n = P->n;
+    const int dim = m->dim;
+    for (size_t i = 0; i < n; i++) {
+        const int on = P->kind[i] != LUB_FLUID && P->patch[i] == patch;
+        for (int d = 0; d < 3; d++)
+            f[d][i] = on && P->kind[i] == LUB_WALL && d < dim ? -P->p[i] * area[d][i] : 0.0;
+    }
+    if (m->c.viscosity == LUB_VISCOSITY_NONE) return;
+    const double mu = m->c.rho * m->c.nu;
+    for (size_t i = 0; i < n; i++) {
+        if (P->kind[i] != LUB_WALL || P->patch[i] != patch) continue;
+        const double a[3] = {area[0][i], area[1][i], area[2][i]};
+        const double wxa[3] = {omega[1] * a[2] - omega[2] * a[1], omega[2] * a[0] - omega[0] * a[2],
+                               omega[0] * a[1] - omega[1] * a[0]};
+        for (int d = 0; d < dim; d++) f[d][i] -= mu * wxa[d];
+    }
+    double dv = m->c.rho;
+    for (int d = 0; d < dim; d++) dv *= m->l0;
+    const double k = dv * lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, m->c.nu);
+    const double gm = m->c.mirror_dummies ? 2.0 : 1.0;
+    const lub_neighbours *nb = &m->nb;
+    for (size_t i = 0; i < n; i++) {
+        if (P->kind[i] != LUB_FLUID) continue;
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+            const size_t j = nb->j[q];
+            if (nb->w[q] <= 0 || P->kind[j] == LUB_FLUID || P->patch[j] != patch) continue;
+            const double c = k * nb->w[q] * (P->kind[j] == LUB_DUMMY ? gm : 1.0);
+            for (int d = 0; d < dim; d++) f[d][j] -= c * (P->u[d][j] - m->us[d][i]);
+        }
+    }
+}
+
 const lub_fluid_type lub_fluid_mps = {
     .name = "mps",
     .read = mps_read,
@@ -72,4 +139,5 @@ const lub_fluid_type lub_fluid_mps = {
     .header_level = mps_header_level,
     .header = mps_header,
     .log = mps_log,
+    .wall_forces = mps_wall_forces,
 };
