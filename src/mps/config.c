@@ -47,6 +47,7 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->clip_negative = 1;
     c->alpha = 0.0;
     c->gamma = 0.2;
+    c->source = LUB_SOURCE_PND;
     c->predictor = 0.1;
     c->beta = 0.97;
     c->surface_test = LUB_SURFACE_SECTOR;
@@ -111,6 +112,8 @@ static void read_schemes(lub_mps_config *c, const char *path)
     c->alpha = lub_dict_real_or(p, "alpha", 0.0, LUB_NONNEGATIVE);
     c->gamma = lub_dict_real_or(p, "gamma", 0.2, (lub_range){0.0, 1.0, 1, 0});
     c->predictor = lub_dict_real_or(p, "predictor", c->predictor, LUB_BETWEEN(0.0, 1.0));
+    static const char *const sources[] = {"pnd", "mixed", NULL};
+    c->source = lub_dict_choice(p, "source", sources, LUB_SOURCE_PND);
     lub_node *fs = lub_dict_map_or(r, "freeSurface");
     c->beta = lub_dict_real_or(fs, "beta", 0.97, (lub_range){0.0, 1.0, 1, 1});
     static const char *const stest[] = {"sector", "centroid", "pnd", NULL};

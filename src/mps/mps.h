@@ -57,6 +57,8 @@
 #include "particles/particles.h"
 
 enum { LUB_GRADIENT_STANDARD = 0, LUB_GRADIENT_LSMPS = 1 };
+/* pressure.source: the PND deviation alone (T-9), or with the divergence of u* (mixed) */
+enum { LUB_SOURCE_PND = 0, LUB_SOURCE_MIXED = 1 };
 enum { LUB_VISCOSITY_NONE = 0, LUB_VISCOSITY_EXPLICIT = 1, LUB_VISCOSITY_CN = 2 };
 enum { LUB_NEGATIVE_KEEP = 0, LUB_NEGATIVE_CLIP = 1, LUB_NEGATIVE_CAVITATION = 2 };
 enum { LUB_SURFACE_SECTOR = 0, LUB_SURFACE_CENTROID = 1, LUB_SURFACE_PND = 2 };
@@ -70,6 +72,7 @@ typedef struct {
     int clip_negative;      /* LUB_NEGATIVE_*: negative pressure kept, set to 0 after the
                                solve, or held at 0 by the cavitation condition */
     double alpha, gamma;    /* T-9 */
+    int source;             /* LUB_SOURCE_*: the pressure equation's source (step.c, pressure) */
     double predictor;       /* weight of the newest pressure gradient in the running mean
                                that the viscous predictor feels (0: off; see lub_mps_step) */
     double beta;            /* free surface: n* < beta n0 (T-12) */
@@ -183,7 +186,8 @@ struct lub_mps {
 
     size_t cap;
     double *us[3]; /* u* */
-    double *pnd;   /* n* */
+    double *pnd;
+    double *div; /* pressure.source mixed: the divergence of u* at r* (fluid particles) */ /* n* */
     uint8_t *surface;
     uint8_t *anchor;       /* pressure row next to a Dirichlet particle (step.c, isolated_groups) */
     int nlattice;          /* lattice neighbours within re (2-D: 28 at re = 3.1 l0, 12 at 2.1) */

@@ -84,6 +84,7 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
         m->grad[d] = alloc_doubles(n);
     }
     m->pnd = alloc_doubles(n);
+    m->div = c->source == LUB_SOURCE_MIXED ? alloc_doubles(n) : NULL;
     m->lap = alloc_doubles(n);
     m->b = alloc_doubles(n);
     m->x = alloc_doubles(n);
@@ -117,6 +118,7 @@ void lub_mps_free(lub_mps *m)
         free(m->grad[d]);
     }
     free(m->pnd);
+    free(m->div);
     free(m->lap);
     free(m->b);
     free(m->x);
@@ -733,6 +735,29 @@ static size_t isolated_groups(lub_mps *m, int nu)
  * pressure, b_i + c sum_j w_ij P_j > 0 (the multiplier changes sign).  In a steady flow the
  * set settles to the complementarity solution; each step costs one solve, as with clip.
  * The set is the particle field "cavitation" (saved with the particles: exact restart). */
+/* The divergence of u* at r* of every fluid particle into m->div (pressure.source mixed), by
+ * the scheme's gradient (T-13 or T-15) of each velocity component over the fluid, wall and
+ * dummy neighbours (the walls' particles carry their wall's velocity), without the pressure
+ * gradient's minimum shift; m->grad is free until step 7. */
+static void divergence(lub_mps *m)
+{
+    const lub_particles *P = m->P;
+    const size_t n = P->n;
+    lub_mps_mask vm = {P->kind, K_FLUID, K_FLUID | K_WALL | K_DUMMY};
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) m->div[i] = 0.0;
+    for (int d = 0; d < m->dim; d++) {
+        if (m->c.gradient == LUB_GRADIENT_LSMPS)
+            lub_mps_gradient_lsmps(&m->nb, &vm, m->n0, 0, m->c.lsmps_det_min, m->us[d], m->grad);
+        else
+            lub_mps_gradient(&m->nb, &vm, m->n0, 0, m->us[d], m->grad);
+        const double *gd = m->grad[d];
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++)
+            if (P->kind[i] == LUB_FLUID) m->div[i] += gd[i];
+    }
+}
+
 static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
 {
     lub_particles *P = m->P;
@@ -740,6 +765,11 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
     const size_t n = P->n;
     const double c = lub_mps_laplacian_coefficient(m->dim, m->lambda0, m->n0, 1.0);
     const double src = m->c.gamma * m->c.rho / (dt * dt) / m->n0;
+    /* mixed source: the projection's rho/dt div u* (the steady pressure needs no lasting PND
+     * excess) besides the PND term, which keeps the particle density in check */
+    const double dsrc = m->div ? m->c.rho / dt : 0.0;
+    const double dlim = m->c.beta * m->n0; /* a full neighbourhood: away from the surface */
+    if (m->div) divergence(m);
     const double alpha = m->c.alpha;
     /* multi-resolution fixed band: the given pressure P->p of a fixed particle is a Dirichlet
      * value (it wins over the free-surface test, whose truncated neighbourhood at the edge of
@@ -797,6 +827,7 @@ assemble:
         col[dg] = r;
         val[dg] = c * wsum + alpha;
         m->b[r] = src * (m->pnd[i] - m->n0);
+        if (dsrc > 0 && P->kind[i] == LUB_FLUID && m->pnd[i] >= dlim) m->b[r] -= dsrc * m->div[i];
         if (fix) m->b[r] += c * bfix;
         m->x[r] = P->p[i]; /* warm start from the previous pressure */
     }
