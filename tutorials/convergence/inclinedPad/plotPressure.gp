@@ -1,5 +1,6 @@
 # The MPS wall pressure under the pad (mean over the second half of the run, probe
-# wallPressure -facing down) against the Reynolds equation.  Run by Allrun, or from the case
+# wallPressure -facing down) against the Reynolds equation, as it is (p = 0 at both edges)
+# and with the pad's ends at the pressures Allrun fits.  Run by Allrun, or from the case
 # folder after it: gnuplot -e "filmOverL0 = 4; window = '0.0005-0.001 s'" plotPressure.gp
 if (!exists("filmOverL0")) filmOverL0 = 4
 if (!exists("window")) window = "second half of the run"
@@ -18,5 +19,7 @@ set grid
 set key top left
 plot "postProcessing/reynoldsRef/0/p.dat" using ($1*1e3):($2*1e-3) with lines lw 2 lc rgb "black" \
          title "Reynolds (the closed form)", \
+     "postProcessing/reference/p.dat" using ($1*1e3):($2*1e-3) with lines lw 1 dt 2 lc rgb "blue" \
+         title "Reynolds with the ends' pressures fitted (Allrun)", \
      "postProcessing/probe/padPressure.dat" using ($1*1e3):($2*1e-3) with points pt 7 ps 0.8 \
          lc rgb "red" title "MPS, pad's lower face, mean ".window
