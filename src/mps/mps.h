@@ -85,6 +85,10 @@ typedef struct {
     int reorder_interval;   /* steps between sorts of the particles (0: never) */
     int order_rows;         /* the sort: 0 cell order, 1 lattice rows of l0 */
     int mirror_dummies;     /* dummies take the no-slip ghost velocity 2 U - u_i (viscosity) */
+    double list_l0;         /* set by the fluid's formulation or a model, not read: the
+                               neighbour lists reach at least list_l0 l0 when built (MPH:
+                               h_v = 3.5 l0, models/fluid/mph.c), by a larger skin; their
+                               weights w stay those of re (0 beyond); 0: re (1 + skin) */
 
     /* system/solution.yaml */
     lub_linsolver_options p_solver, v_solver;
@@ -95,6 +99,7 @@ typedef struct {
     int gravity;   /* a uniform body acceleration g given with the configuration (callers */
     double g[3];   /* without models; the models of a scene add theirs: hooks.forces) */
     int viscosity; /* LUB_VISCOSITY_* */
+    double bulk_viscosity, bulk_modulus; /* MPH lambda [Pa s], kappa [Pa] (models/fluid/mph.c) */
     double patch_velocity[LUB_MAX_PATCHES][3]; /* wall velocities (movingWalls) */
     int patch_moved[LUB_MAX_PATCHES]; /* 1: a model sets the velocity of the patch's wall and
                                          dummy particles before each step (elasticWall) */
@@ -205,6 +210,11 @@ struct lub_mps {
     void *scratch;
     long steps; /* global step count (from the particle file) */
     int built;  /* neighbour lists built once */
+
+    /* a formulation's own work arrays (models/fluid.h; NULL for mps), freed by
+     * lub_mps_free with fstate_free */
+    void *fstate;
+    void (*fstate_free)(void *fstate);
 
     lub_mps_stats st;
     double iterations[2]; /* pressure and viscosity iterations of every step so far */

@@ -54,7 +54,11 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
         m->hi[d] = hi[d];
         m->periodic[d] = periodic[d];
     }
-    lub_neighbours_init(&m->nb, m->dim, m->re, c->skin, lo, hi, periodic);
+    /* lists reaching list_l0 l0 beyond re (a formulation's or a model's wider kernel): a
+     * larger skin, the weights still of re (pairs beyond re stored with w = 0) */
+    double skin = c->skin;
+    if (c->list_l0 * m->l0 > m->re * (1 + skin)) skin = c->list_l0 * m->l0 / m->re - 1;
+    lub_neighbours_init(&m->nb, m->dim, m->re, skin, lo, hi, periodic);
     lub_neighbours_set_order(&m->nb, c->order_rows ? m->l0 : 0.0);
     lub_csr_init(&m->A);
     lub_csr_init(&m->A2);
@@ -104,6 +108,7 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
 
 void lub_mps_free(lub_mps *m)
 {
+    if (m->fstate_free) m->fstate_free(m->fstate);
     for (int d = 0; d < 3; d++) {
         free(m->us[d]);
         free(m->bv[d]);
@@ -908,7 +913,9 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     /* 1. neighbours at r^k; the particles sorted every reorder_interval steps */
     /* the reorder schedule follows the global step, so that a restarted run sorts at the
      * same steps as an uninterrupted one (exact restart) */
-    int rebuild = !m->built;
+    /* lists reaching beyond re (list_l0) are complete to their radius only when built: the
+     * update keeps the pairs within re */
+    int rebuild = !m->built || m->c.list_l0 * m->l0 > m->re;
     m->built = 1;
     if (m->c.reorder_interval > 0 && m->steps % m->c.reorder_interval == 0) {
         lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
