@@ -6,6 +6,7 @@
  *     2. viscosity and body force -> u*           explicit (T-7) or Crank-Nicolson (T-31)
  *        (pressure predictor: with the force -G/rho of the running mean G of the pressure
  *        gradient, which is then added back: u* += dt G / rho)
+ *        and the models' per-particle forces at r^k (surface tension): u* += dt F/m
  *     3. temporary positions r* = r^k + u* dt      (T-8); walls move with their velocity
  *     4. PND n* at r*                              (T-11)
  *     5. free surface: n* < beta n0, refined by geometric tests   (T-12): the neighbours'
@@ -19,8 +20,8 @@
  *        domain box, a fluid particle through a wall: lub_mps_check)
  *
  * Models act at named points of the step through lub_mps.hooks (src/models/model.h fills
- * them in for the models of a scene): forces in step 2 (gravity), after the correction in
- * step 9 (collision).  The step knows no model by name.
+ * them in for the models of a scene): forces in step 2 (gravity), particle forces after it
+ * (surface tension), after the correction in step 9 (collision).  The step knows no model by name.
  *
  * Pressure predictor (schemes.yaml pressure.predictor, not in the thesis).  Without it, a
  * steady flow balances grad p / rho = nu lap(u*) with u* = u + dt grad p / rho: the viscous
@@ -156,6 +157,12 @@ typedef struct {
     /* step 9, after the correction (u^{k+1}, r^{k+1}) and before the periodic wrap and the
      * checks: a change of the fluid particles' velocities and positions (collision) */
     void (*after_correction)(void *ctx, lub_mps *m, double dt);
+    /* forces that depend on the particles (surface tension): add each fluid particle's
+     * acceleration [m/s^2] to acc[d][i] (zeroed by the caller), from the lists of the step
+     * (complete to list_l0 l0) at the current positions; returns 1 if it added any.  The
+     * fluid's step adds dt acc to u* (lub_mps_particle_forces): MPS after the viscous step
+     * (at r^k), MPH in its step 4 (at x^{k+1}) */
+    int (*particle_forces)(void *ctx, const lub_mps *m, double *const acc[3]);
 } lub_mps_hooks;
 
 struct lub_mps {
@@ -211,6 +218,8 @@ struct lub_mps {
     long steps; /* global step count (from the particle file) */
     int built;  /* neighbour lists built once */
 
+    double *pacc[3]; /* hooks.particle_forces' accelerations (allocated at the first step
+                        that has the hook) */
     /* a formulation's own work arrays (models/fluid.h; NULL for mps), freed by
      * lub_mps_free with fstate_free */
     void *fstate;
@@ -263,6 +272,11 @@ lub_step_status lub_mps_check(lub_mps *m, double dt, long *bad, char *msg, size_
  * layer (the criterion of lub_mps_check, whatever its position before the step); returns
  * their count.  The caller removes them (models/multiResolution/opt.c). */
 size_t lub_mps_buried(const lub_mps *m, double dt, uint8_t *flag);
+
+/* The per-particle forces of the models (hooks.particle_forces, if any): us[d][i] += dt
+ * acc[d][i] for the fluid particles that are not given (lub_mps.fixed); the lists must be
+ * those of the current positions.  Shared by the formulations (models/fluid.h). */
+void lub_mps_particle_forces(lub_mps *m, double dt, double *const us[3]);
 
 /* Build the neighbour lists afresh at the next step.  The solver calls it after writing a
  * time folder, so that a run restarted from that folder (whose lists are built afresh)

@@ -109,6 +109,7 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
 void lub_mps_free(lub_mps *m)
 {
     if (m->fstate_free) m->fstate_free(m->fstate);
+    for (int d = 0; d < 3; d++) free(m->pacc[d]);
     for (int d = 0; d < 3; d++) {
         free(m->us[d]);
         free(m->bv[d]);
@@ -882,6 +883,20 @@ assemble:
     return 0;
 }
 
+void lub_mps_particle_forces(lub_mps *m, double dt, double *const us[3])
+{
+    if (!m->hooks.particle_forces) return;
+    const lub_particles *P = m->P;
+    if (!m->pacc[0]) /* the first step with the hook: for the capacity, never again */
+        for (int d = 0; d < 3; d++) m->pacc[d] = alloc_doubles(m->cap);
+    for (int d = 0; d < 3; d++) memset(m->pacc[d], 0, P->n * sizeof(double));
+    if (!m->hooks.particle_forces(m->hooks.ctx, m, m->pacc)) return;
+    const uint8_t *fix = m->fixed;
+    for (int d = 0; d < m->dim; d++)
+        for (size_t i = 0; i < P->n; i++)
+            if (P->kind[i] == LUB_FLUID && !(fix && fix[i])) us[d][i] += dt * m->pacc[d][i];
+}
+
 /* Wrap periodic coordinates into [lo, hi). */
 static void wrap(lub_mps *m)
 {
@@ -935,6 +950,8 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     int body = m->c.gravity;
     if (m->hooks.forces && m->hooks.forces(m->hooks.ctx, m, dt, g)) body = 1;
     if (viscosity(m, dt, g, body, msg, msgsize)) return LUB_STEP_SOLVE_FAILED;
+    /* the models' per-particle forces (surface tension), explicit at r^k */
+    lub_mps_particle_forces(m, dt, m->us);
 
     /* 3. temporary positions (T-8); with still_walls only the fluid moves (the walls are at
      * rest or slide along themselves: their particles carry the velocity in place), and the

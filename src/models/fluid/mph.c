@@ -470,12 +470,14 @@ lub_step_status lub_mph_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     lub_timer_start(&m->tm, LUB_T_ASSEMBLY);
     density(m, S);
 
-    /* 4. u* = u^k + dt g (the configuration's and the models' body acceleration) */
+    /* 4. u* = u^k + dt (F^s/m + g) (the configuration's and the models' body acceleration,
+     * the models' per-particle forces) */
     double g[3] = {m->c.g[0], m->c.g[1], m->c.g[2]};
     if (m->hooks.forces) m->hooks.forces(m->hooks.ctx, m, dt, g);
     for (int d = 0; d < dim; d++)
         for (size_t i = 0; i < n; i++)
             m->us[d][i] = P->kind[i] == LUB_FLUID ? P->u[d][i] + dt * g[d] : P->u[d][i];
+    lub_mps_particle_forces(m, dt, m->us); /* F^s / m (surface tension), explicit */
 
     /* 5. the velocities at k+1 */
     const int nf = assemble(m, S, dt);
