@@ -315,10 +315,109 @@ static void test_force_is_gradient(void)
     lub_geometry_free(&g);
 }
 
+/* N_i = min(n^a_i - n0^a, 0) of particle i, formed here (2-D, l0 = 1e-4 m, wall factor c) */
+static double deficit(const lub_particles *P, size_t i, double c)
+{
+    const double l0 = 1e-4, h = 3.5;
+    double n0 = 0, n = 0;
+    for (int x = -4; x <= 4; x++)
+        for (int y = -4; y <= 4; y++)
+            if (x || y) n0 += k_wa(sqrt(x * x + y * y), h);
+    for (size_t j = 0; j < P->n; j++) {
+        if (j == i) continue;
+        const double r = hypot(P->x[0][j] - P->x[0][i], P->x[1][j] - P->x[1][i]) / l0;
+        const int same = (P->kind[i] == LUB_FLUID) == (P->kind[j] == LUB_FLUID);
+        n += (same ? 1.0 : c) * k_wa(r, h);
+    }
+    return fmin(n - n0, 0.0);
+}
+
+/* A 2-D liquid bridge between plates H = 20 l0 apart (a wall layer and 3 dummy layers
+ * each), contact angle 60 degrees on both, no gravity, from a rectangle of fluid; after
+ * 0.06 s: the pressure in the middle of the bridge (|x| < 5 l0, within 5 l0 of mid-height),
+ * P of (K-7a) plus the cohesive pressure a N (CPP in the stretched bulk, formed here; the
+ * model's field pCohesive to round-off) against Laplace's -sigma / R with R the radius of
+ * the meniscus (the circle through its ends, the first and last rows, and its waist),
+ * within 10%; the meniscus' angle at its ends within 5 degrees of 60 (the table's; -2 sigma
+ * cos(60) / H = -15 Pa). */
+static void test_bridge(void)
+{
+    lub_particles P = {0};
+    const char *geo = "dimension: 2\n"
+                      "l0: 1.0e-4\n"
+                      "domain: { min: [-0.003, -0.0006], max: [0.003, 0.0026] }\n"
+                      "dummyLayers: 3\n"
+                      "walls:\n"
+                      "  lower: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+                      "  upper: { type: plane, point: [0, 0.002], normal: [0, -1] }\n"
+                      "fluid:\n"
+                      "  - { type: box, min: [-0.001, 0], max: [0.001, 0.002] }\n";
+    char path[] = "/tmp/stbridgeXXXXXX";
+    int fd = mkstemp(path);
+    if (fd < 0 || write(fd, geo, strlen(geo)) != (ssize_t)strlen(geo)) abort();
+    close(fd);
+    lub_geometry g;
+    lub_geometry_read(&g, path);
+    unlink(path);
+    lub_geometry_discretise(&g, &P, 0, NULL);
+    lub_mps_config c;
+    config(&c, 1000, 1e-4, 1.0, 3e3);
+    driver d;
+    model_read(&d, &P, "surfaceTension: { sigma: 0.03, contactAngle: { lower: 60, upper: 60 } }\n",
+               &c);
+    lub_mps m;
+    lub_mps_init(&m, &P, &c, g.dmin, g.dmax, g.periodic);
+    model_attach(&d, &m);
+    const double l0 = 1e-4, H = 0.002, sigma = 0.03, k = 0.350778153;
+    const double a = sigma / (3.5 * l0 * (0.024679383 + k * k * 0.226126699));
+    const char *ns = getenv("LUB_STEPS");
+    const int nsteps = ns ? atoi(ns) : 3000;
+    const double *pc = lub_particles_find_extra(&P, "pCohesive");
+    double pin = 0, rlap = 0, theta = 0, dpc = 0, spc = 0;
+    for (int step = 0; step < nsteps; step += 500) {
+        if (run(&m, 2e-5, 500)) break;
+        double sp = 0, sn = 0, xl = INFINITY, xr = -INFINITY, bl = INFINITY, br = -INFINITY;
+        int cnt = 0;
+        for (size_t i = 0; i < P.n; i++) {
+            if (P.kind[i] != LUB_FLUID) continue;
+            if (fabs(P.x[1][i] - 0.5 * H) < 0.5 * l0)
+                xl = fmin(xl, P.x[0][i]), xr = fmax(xr, P.x[0][i]);
+            if (fabs(P.x[1][i] - l0) < 0.5 * l0 || fabs(P.x[1][i] - (H - l0)) < 0.5 * l0)
+                bl = fmin(bl, P.x[0][i]), br = fmax(br, P.x[0][i]);
+            if (fabs(P.x[0][i]) < 5 * l0 && fabs(P.x[1][i] - 0.5 * H) < 5 * l0) {
+                const double an = a * deficit(&P, i, 0.6);
+                sp += P.p[i], sn += an, cnt++;
+                dpc = fmax(dpc, fabs(pc[i] - an)), spc = fmax(spc, fabs(an));
+            }
+        }
+        /* the meniscus: the circle through its ends (the first and last rows) and its waist */
+        const double sag = 0.5 * ((xr - xl) - (br - bl)) * -1, half = 0.5 * (H - 2 * l0);
+        const double R = (half * half + sag * sag) / (2 * sag);
+        if (getenv("LUB_PROFILE"))
+            printf(
+                "  t %.3f s: middle P %.4g Pa, a N %.4g Pa, sum %.4g Pa; -sigma/R %.4g Pa (R %.2f "
+                "l0, the meniscus' angle %.1f deg); -2 sigma cos 60 / H = %.4g Pa\n",
+                (step + 500) * 2e-5, sp / cnt, sn / cnt, (sp + sn) / cnt, -sigma / R, R / l0,
+                acos(half / R) * 180 / M_PI, -2 * sigma * 0.5 / H);
+        pin = (sp + sn) / cnt, rlap = -sigma / R, theta = acos(half / R) * 180 / M_PI;
+    }
+    printf("  the bridge's pressure %.4g Pa against -sigma/R %.4g Pa: ratio %.4f; the "
+           "meniscus' angle %.1f deg; pCohesive against a N formed here: %.2g of %.3g Pa\n",
+           pin, rlap, pin / rlap, theta, dpc, spc);
+    CHECK(fabs(pin / rlap - 1) < 0.1);
+    CHECK(fabs(theta - 60) < 5);
+    CHECK(dpc < 1e-9 * spc);
+    lub_mps_free(&m);
+    model_free(&d);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
 int main(void)
 {
     RUN(test_force_is_gradient);
     RUN(test_laplace_2d);
     RUN(test_laplace_mps);
+    RUN(test_bridge);
     return test_summary();
 }

@@ -35,6 +35,12 @@
  * does not hold (CPP is quadratic in the density deficit); c is interpolated in the table
  * of angles measured on 2-D sessile drops (doc/methods.md §8, tests/bench/sessile_bench.c).
  *
+ * The particle field pCohesive = a N_i is the cohesive pressure: CPP's pair term has the form
+ * of (K-6)'s pressure term with a N_i for P_i, and where the fluid is stretched (n^a < n0^a
+ * in the bulk: a liquid bridge, a film in tension) it carries the tension, while P of
+ * (K-7a) stays near 0 (its elastic part is compression-only).  P + pCohesive is the
+ * pressure to compare with -2 sigma cos(theta)/H (doc/methods.md §8).
+ *
  * Both fluids call it with the explicit forces (particle_forces, models/model.h); the lists
  * must reach h_s = 3.5 l0 (configure: list_l0). */
 #include <math.h>
@@ -60,6 +66,7 @@ typedef struct {
     double l0, hs, a, k, R2, n0a;
     size_t cap;
     double *na, *chi[3];
+    double *pc;            /* the particle field pCohesive: a N_i, the cohesive (CPP) pressure */
     int walls_done;        /* the walls' own parts formed */
     double *naw, *chiw[3]; /* the walls' own n^a and chi (wall and dummy particles) */
 } surface;
@@ -197,6 +204,7 @@ static void st_init(lub_model *m, lub_scene *s)
     S->na = lub_calloc(S->cap ? S->cap : 1, sizeof(double));
     for (int d = 0; d < 3; d++) S->chi[d] = lub_calloc(S->cap ? S->cap : 1, sizeof(double));
     S->naw = lub_calloc(S->cap ? S->cap : 1, sizeof(double));
+    S->pc = lub_particles_extra(s->P, "pCohesive");
     for (int d = 0; d < 3; d++) S->chiw[d] = lub_calloc(S->cap ? S->cap : 1, sizeof(double));
 }
 
@@ -279,6 +287,7 @@ static int st_particle_forces(lub_model *m, const lub_mps *f, double *const acc[
     }
     for (size_t i = 0; i < P->n; i++) {
         S->na[i] = fmin(S->na[i] - S->n0a, 0.0); /* N_i: CPP only where n^a < n0^a */
+        S->pc[i] = S->a * S->na[i];
         for (int d = 0; d < dim; d++) S->chi[d][i] *= ch;
     }
     const double dA = dim == 2 ? l0 * l0 : l0 * l0 * l0;
