@@ -273,6 +273,12 @@ lub_step_status lub_mps_check(lub_mps *m, double dt, long *bad, char *msg, size_
  * their count.  The caller removes them (models/multiResolution/opt.c). */
 size_t lub_mps_buried(const lub_mps *m, double dt, uint8_t *flag);
 
+/* Sort every per-particle array (the particles' fields and extra fields, fixed, inside) into
+ * the order of system/schemes.yaml particleOrder (cells or lattice rows); the neighbour lists
+ * must be built afresh after it.  The MPS step does it every reorderInterval steps; a
+ * formulation's step may too (models/fluid.h), whose own arrays are formed anew each step. */
+void lub_mps_reorder(lub_mps *m);
+
 /* The per-particle forces of the models (hooks.particle_forces, if any): us[d][i] += dt
  * acc[d][i] for the fluid particles that are not given (lub_mps.fixed); the lists must be
  * those of the current positions.  Shared by the formulations (models/fluid.h). */

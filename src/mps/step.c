@@ -144,7 +144,7 @@ void lub_mps_free(lub_mps *m)
  * particles move to other cells, so the sort is repeated every step by default
  * (reorderInterval 1: on the thesis wedge 10% faster than lattice rows sorted every 50 steps,
  * the sort included). */
-static void reorder(lub_mps *m)
+void lub_mps_reorder(lub_mps *m)
 {
     lub_particles *P = m->P;
     double *x[3] = {P->x[0], P->x[1], P->x[2]};
@@ -934,7 +934,7 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     m->built = 1;
     if (m->c.reorder_interval > 0 && m->steps % m->c.reorder_interval == 0) {
         lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
-        reorder(m);
+        lub_mps_reorder(m);
         lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
         rebuild = 1;
     }

@@ -463,8 +463,14 @@ lub_step_status lub_mph_step(lub_mps *m, double dt, long *bad, char *msg, size_t
         for (size_t i = 0; i < n; i++) P->x[d][i] += dt * P->u[d][i];
     lub_timer_stop(&m->tm, LUB_T_OTHER);
 
-    /* 2. neighbours at x^{k+1}, built afresh (an update keeps only the pairs within re);
-     * 3. n_i, P^kap */
+    /* 2. neighbours at x^{k+1}, built afresh (an update keeps only the pairs within re),
+     * the particles sorted first every reorderInterval steps (the global step: a restart
+     * sorts at the same steps); 3. n_i, P^kap */
+    if (m->c.reorder_interval > 0 && m->steps % m->c.reorder_interval == 0) {
+        lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
+        lub_mps_reorder(m);
+        lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
+    }
     m->built = 1;
     neighbours(m, 1);
     lub_timer_start(&m->tm, LUB_T_ASSEMBLY);
