@@ -7,8 +7,9 @@
  * into the solver's configuration and brings its step; it shares the solver's state (mps/mps.h
  * lub_mps: the particles and their fields, the neighbour lists, the wall and dummy particles
  * and their checks, the linear solvers, the timers), and with it the models' hooks, the
- * output and the run control.  Semi-implicit MPS (methods.md §2) is `mps`; a second
- * formulation (MPH, SPH) is a second file with its own step over the same state.  A model
+ * output and the run control.  Semi-implicit MPS (methods.md §2) is `mps`; Moving Particle
+ * Hydrodynamics (methods.md §8) is `mph` (models/fluid/mph.h), a second file with its own
+ * step over the same state.  A model
  * that drives the levels itself (multiResolution) couples steps of `mps` and refuses others.
  */
 #ifndef LUB_MODELS_FLUID_H
@@ -16,6 +17,7 @@
 
 #include <stddef.h>
 
+#include "geometry/geometry.h"
 #include "io/case.h"
 #include "io/dict.h"
 #include "mps/mps.h"
@@ -32,6 +34,12 @@ typedef struct lub_fluid_type {
      * (schemes, linear solvers). */
     void (*header_level)(const lub_mps *m);
     void (*header)(const lub_mps *m);
+    /* Its start-up checks (NULL: none), after the header and the Courant and diffusion
+     * numbers (lubFoam): its parameters against the step dt and the body acceleration g of
+     * the scene's models (uniform, m/s^2), the case's geometry (system/particleGenDict.yaml)
+     * against its needs; printed as the MPS solver's, fatal (exit 1, file:line where there is
+     * one) for a combination that cannot work. */
+    void (*check)(const lub_mps *m, const lub_geometry *geo, double dt, const double g[3]);
     /* Its part of the log line after the step (dt; pit: the mean pressure iterations per
      * step so far). */
     void (*log)(const lub_mps *m, double dt, double pit, char *buf, size_t size);

@@ -34,6 +34,8 @@
  *                      finest level (multiResolution: the coupling, sub-steps, transfer and
  *                      mass correction); without a driver the scene takes the solver's step
  *   forces             step 2 of every level's step: add a uniform body acceleration
+ *   particle_forces    with the explicit forces (MPS: after the viscous step; MPH: its
+ *                      step 4): add each fluid particle's acceleration (surface tension)
  *   after_correction   step 9, after the velocity and position correction: collision
  *   after_step         after every level's step, the time now t + dt (elasticWall: the
  *                      running mean of the wall pressure); the driver's last (it gathers the
@@ -89,6 +91,10 @@ typedef struct lub_model_type {
                                    size_t msgsize);
     /* inside the step of each level's solver f (mps.h lub_mps_hooks) */
     int (*forces)(lub_model *m, const lub_mps *f, double dt, double acc[3]);
+    /* inside the step of each level's solver f: add the acceleration of forces that depend on
+     * the particles (surface tension) to acc[d][i] of the fluid particles; 1 if it added
+     * any (mps.h lub_mps_hooks.particle_forces) */
+    int (*particle_forces)(lub_model *m, const lub_mps *f, double *const acc[3]);
     void (*after_correction)(lub_model *m, lub_mps *f, double dt);
     lub_step_status (*advance)(lub_model *m, lub_scene *s, double dt, long *bad, char *msg,
                                size_t msgsize);

@@ -64,18 +64,30 @@ static void scene_after_correction(void *ctx, lub_mps *f, double dt)
             s->model[k].type->after_correction(&s->model[k], f, dt);
 }
 
+static int scene_particle_forces(void *ctx, const lub_mps *f, double *const acc[3])
+{
+    lub_scene *s = ctx;
+    int any = 0;
+    for (int k = 0; k < s->nmodels; k++)
+        if (s->model[k].type->particle_forces)
+            any |= s->model[k].type->particle_forces(&s->model[k], f, acc);
+    return any;
+}
+
 static void attach(lub_scene *s, lub_mps *const *levels, int nlevels)
 {
-    int forces = 0, after = 0;
+    int forces = 0, after = 0, pforces = 0;
     for (int k = 0; k < s->nmodels; k++) {
         forces |= s->model[k].type->forces != NULL;
         after |= s->model[k].type->after_correction != NULL;
+        pforces |= s->model[k].type->particle_forces != NULL;
     }
     for (int l = 0; l < nlevels; l++) {
         lub_mps_hooks *h = &levels[l]->hooks;
         h->ctx = s;
         h->forces = forces ? scene_forces : NULL;
         h->after_correction = after ? scene_after_correction : NULL;
+        h->particle_forces = pforces ? scene_particle_forces : NULL;
     }
 }
 

@@ -6,6 +6,7 @@
  *     2. viscosity and body force -> u*           explicit (T-7) or Crank-Nicolson (T-31)
  *        (pressure predictor: with the force -G/rho of the running mean G of the pressure
  *        gradient, which is then added back: u* += dt G / rho)
+ *        and the models' per-particle forces at r^k (surface tension): u* += dt F/m
  *     3. temporary positions r* = r^k + u* dt      (T-8); walls move with their velocity
  *     4. PND n* at r*                              (T-11)
  *     5. free surface: n* < beta n0, refined by geometric tests   (T-12): the neighbours'
@@ -19,8 +20,8 @@
  *        domain box, a fluid particle through a wall: lub_mps_check)
  *
  * Models act at named points of the step through lub_mps.hooks (src/models/model.h fills
- * them in for the models of a scene): forces in step 2 (gravity), after the correction in
- * step 9 (collision).  The step knows no model by name.
+ * them in for the models of a scene): forces in step 2 (gravity), particle forces after it
+ * (surface tension), after the correction in step 9 (collision).  The step knows no model by name.
  *
  * Pressure predictor (schemes.yaml pressure.predictor, not in the thesis).  Without it, a
  * steady flow balances grad p / rho = nu lap(u*) with u* = u + dt grad p / rho: the viscous
@@ -91,6 +92,10 @@ typedef struct {
     int reorder_interval;   /* steps between sorts of the particles (0: never) */
     int order_rows;         /* the sort: 0 cell order, 1 lattice rows of l0 */
     int mirror_dummies;     /* dummies take the no-slip ghost velocity 2 U - u_i (viscosity) */
+    double list_l0;         /* set by the fluid's formulation or a model, not read: the
+                               neighbour lists reach at least list_l0 l0 when built (MPH:
+                               h_v = 3.5 l0, models/fluid/mph.c), by a larger skin; their
+                               weights w stay those of re (0 beyond); 0: re (1 + skin) */
 
     /* system/solution.yaml */
     lub_linsolver_options p_solver, v_solver;
@@ -101,6 +106,7 @@ typedef struct {
     int gravity;   /* a uniform body acceleration g given with the configuration (callers */
     double g[3];   /* without models; the models of a scene add theirs: hooks.forces) */
     int viscosity; /* LUB_VISCOSITY_* */
+    double bulk_viscosity, bulk_modulus; /* MPH lambda [Pa s], kappa [Pa] (models/fluid/mph.c) */
     double patch_velocity[LUB_MAX_PATCHES][3]; /* wall velocities (movingWalls); on a patch
                                                   a model moves: a velocity of its largest
                                                   speed (lubFoam's Courant number), or 0 */
@@ -160,6 +166,12 @@ typedef struct {
     /* step 9, after the correction (u^{k+1}, r^{k+1}) and before the periodic wrap and the
      * checks: a change of the fluid particles' velocities and positions (collision) */
     void (*after_correction)(void *ctx, lub_mps *m, double dt);
+    /* forces that depend on the particles (surface tension): add each fluid particle's
+     * acceleration [m/s^2] to acc[d][i] (zeroed by the caller), from the lists of the step
+     * (complete to list_l0 l0) at the current positions; returns 1 if it added any.  The
+     * fluid's step adds dt acc to u* (lub_mps_particle_forces): MPS after the viscous step
+     * (at r^k), MPH in its step 4 (at x^{k+1}) */
+    int (*particle_forces)(void *ctx, const lub_mps *m, double *const acc[3]);
 } lub_mps_hooks;
 
 struct lub_mps {
@@ -220,6 +232,13 @@ struct lub_mps {
     long steps; /* global step count (from the particle file) */
     int built;  /* neighbour lists built once */
 
+    double *pacc[3]; /* hooks.particle_forces' accelerations (allocated at the first step
+                        that has the hook) */
+    /* a formulation's own work arrays (models/fluid.h; NULL for mps), freed by
+     * lub_mps_free with fstate_free */
+    void *fstate;
+    void (*fstate_free)(void *fstate);
+
     lub_mps_stats st;
     double iterations[2]; /* pressure and viscosity iterations of every step so far */
     lub_timers tm;
@@ -267,6 +286,17 @@ lub_step_status lub_mps_check(lub_mps *m, double dt, long *bad, char *msg, size_
  * layer (the criterion of lub_mps_check, whatever its position before the step); returns
  * their count.  The caller removes them (models/multiResolution/opt.c). */
 size_t lub_mps_buried(const lub_mps *m, double dt, uint8_t *flag);
+
+/* Sort every per-particle array (the particles' fields and extra fields, fixed, inside) into
+ * the order of system/schemes.yaml particleOrder (cells or lattice rows); the neighbour lists
+ * must be built afresh after it.  The MPS step does it every reorderInterval steps; a
+ * formulation's step may too (models/fluid.h), whose own arrays are formed anew each step. */
+void lub_mps_reorder(lub_mps *m);
+
+/* The per-particle forces of the models (hooks.particle_forces, if any): us[d][i] += dt
+ * acc[d][i] for the fluid particles that are not given (lub_mps.fixed); the lists must be
+ * those of the current positions.  Shared by the formulations (models/fluid.h). */
+void lub_mps_particle_forces(lub_mps *m, double dt, double *const us[3]);
 
 /* Build the neighbour lists afresh at the next step.  The solver calls it after writing a
  * time folder, so that a run restarted from that folder (whose lists are built afresh)

@@ -54,7 +54,11 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
         m->hi[d] = hi[d];
         m->periodic[d] = periodic[d];
     }
-    lub_neighbours_init(&m->nb, m->dim, m->re, c->skin, lo, hi, periodic);
+    /* lists reaching list_l0 l0 beyond re (a formulation's or a model's wider kernel): a
+     * larger skin, the weights still of re (pairs beyond re stored with w = 0) */
+    double skin = c->skin;
+    if (c->list_l0 * m->l0 > m->re * (1 + skin)) skin = c->list_l0 * m->l0 / m->re - 1;
+    lub_neighbours_init(&m->nb, m->dim, m->re, skin, lo, hi, periodic);
     lub_neighbours_set_order(&m->nb, c->order_rows ? m->l0 : 0.0);
     lub_csr_init(&m->A);
     lub_csr_init(&m->A2);
@@ -111,6 +115,8 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
 
 void lub_mps_free(lub_mps *m)
 {
+    if (m->fstate_free) m->fstate_free(m->fstate);
+    for (int d = 0; d < 3; d++) free(m->pacc[d]);
     for (int d = 0; d < 3; d++) {
         free(m->us[d]);
         free(m->bv[d]);
@@ -146,7 +152,7 @@ void lub_mps_free(lub_mps *m)
  * particles move to other cells, so the sort is repeated every step by default
  * (reorderInterval 1: on the thesis wedge 10% faster than lattice rows sorted every 50 steps,
  * the sort included). */
-static void reorder(lub_mps *m)
+void lub_mps_reorder(lub_mps *m)
 {
     lub_particles *P = m->P;
     double *x[3] = {P->x[0], P->x[1], P->x[2]};
@@ -943,6 +949,20 @@ assemble:
     return 0;
 }
 
+void lub_mps_particle_forces(lub_mps *m, double dt, double *const us[3])
+{
+    if (!m->hooks.particle_forces) return;
+    const lub_particles *P = m->P;
+    if (!m->pacc[0]) /* the first step with the hook: for the capacity, never again */
+        for (int d = 0; d < 3; d++) m->pacc[d] = alloc_doubles(m->cap);
+    for (int d = 0; d < 3; d++) memset(m->pacc[d], 0, P->n * sizeof(double));
+    if (!m->hooks.particle_forces(m->hooks.ctx, m, m->pacc)) return;
+    const uint8_t *fix = m->fixed;
+    for (int d = 0; d < m->dim; d++)
+        for (size_t i = 0; i < P->n; i++)
+            if (P->kind[i] == LUB_FLUID && !(fix && fix[i])) us[d][i] += dt * m->pacc[d][i];
+}
+
 /* Wrap periodic coordinates into [lo, hi). */
 static void wrap(lub_mps *m)
 {
@@ -974,11 +994,13 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     /* 1. neighbours at r^k; the particles sorted every reorder_interval steps */
     /* the reorder schedule follows the global step, so that a restarted run sorts at the
      * same steps as an uninterrupted one (exact restart) */
-    int rebuild = !m->built;
+    /* lists reaching beyond re (list_l0) are complete to their radius only when built: the
+     * update keeps the pairs within re */
+    int rebuild = !m->built || m->c.list_l0 * m->l0 > m->re;
     m->built = 1;
     if (m->c.reorder_interval > 0 && m->steps % m->c.reorder_interval == 0) {
         lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
-        reorder(m);
+        lub_mps_reorder(m);
         lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
         rebuild = 1;
     }
@@ -994,6 +1016,8 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     int body = m->c.gravity;
     if (m->hooks.forces && m->hooks.forces(m->hooks.ctx, m, dt, g)) body = 1;
     if (viscosity(m, dt, g, body, msg, msgsize)) return LUB_STEP_SOLVE_FAILED;
+    /* the models' per-particle forces (surface tension), explicit at r^k */
+    lub_mps_particle_forces(m, dt, m->us);
 
     /* 3. temporary positions (T-8); with still_walls only the fluid moves (the walls are at
      * rest or slide along themselves: their particles carry the velocity in place), and the

@@ -97,7 +97,7 @@ static double fraction_done(const lubfoam_run *r, long steps_done)
  * the particles' own speeds only warn: the uninterrupted run met them mid-run, where a
  * Courant number above the limit is a warning too, and a restart must be able to continue
  * it.  At step 0 they count like the walls (a fluid given a velocity). */
-static void check_limits(lubfoam_run *r)
+static void check_limits(lubfoam_run *r, const lub_geometry *geo)
 {
     /* resolution levels: every level takes deltaT (commonDeltaT), so the finest level has the
      * largest Courant and diffusion numbers for a speed; the speed is the fastest of all */
@@ -198,6 +198,8 @@ static void check_limits(lubfoam_run *r)
                   "constant/models.yaml or reduce deltaT to at most %.4g s",
                   dn, m->c.nu, r->dt, r->ctl.max_diffusion,
                   r->ctl.max_diffusion * m->l0 * m->l0 / m->c.nu);
+    /* the formulation's own (MPH: its elastic number, compression, walls) */
+    if (sc->fluid->check) sc->fluid->check(m, geo, r->dt, acc);
 }
 
 /* average, others_running: the load average and the tasks of other programs runnable when
@@ -324,7 +326,7 @@ int main(int argc, char **argv)
     if (!isatty(STDOUT_FILENO)) setvbuf(stdout, NULL, _IOLBF, 0);
     lub_program_info info = {
         .name = "lubFoam",
-        .summary = "semi-implicit MPS solver for thin-film lubrication",
+        .summary = "semi-implicit MPS (or MPH) solver for thin-film lubrication",
         .usage = "[OPTIONS]",
         .description =
             "  Starts from the time folder chosen by startFrom in system/controlDict.yaml,\n"
@@ -347,7 +349,11 @@ int main(int argc, char **argv)
             "  listing them): lubClean removes them first, startFrom: latestTime continues.\n"
             "  -dryRun reads and checks every dictionary and the start particles, prints the\n"
             "  start-up figures (particles, schemes, models, Courant and diffusion numbers,\n"
-            "  multi-resolution checks), runs nothing and writes nothing.",
+            "  multi-resolution checks), runs nothing and writes nothing.\n"
+            "  The fluid is semi-implicit MPS, or with 'fluid: { type: mph, bulkViscosity:\n"
+            "  L, bulkModulus: K }' in constant/models.yaml Moving Particle Hydrodynamics\n"
+            "  (methods.md 8), whose start-up figures add its elastic number and\n"
+            "  hydrostatic compression and which needs walls of dummyLayers: 3.",
         .dictionaries = "system/controlDict.yaml\nsystem/particleGenDict.yaml (domain)\n"
                         "system/schemes.yaml\nsystem/solution.yaml (optional)\n"
                         "constant/transportProperties.yaml\nconstant/models.yaml\n"
@@ -393,7 +399,7 @@ int main(int argc, char **argv)
     lub_dict_finish(r.ctl.dict);
 
     print_header(&r, load_average, others_running);
-    check_limits(&r);
+    check_limits(&r, &geo);
     lubfoam_check_levels(&r, &geo);
     r.scene.geo = NULL;
     lub_geometry_free(&geo);

@@ -1,0 +1,717 @@
+/* lubkit fluid mph: Moving Particle Hydrodynamics, MPH-I (see mph.h; doc/methods.md §8).
+ *
+ * Pairs r_ij = x_j - x_i, e_ij = r_ij / r_ij, u_ij = u_j - u_i.  With g_ij = e_ij w_p'(r_ij)
+ * (antisymmetric: g_ji = -g_ij) and s_i = sum_j u_ij.g_ij (-> -div u), the dissipation
+ * function (K-4) is D = sum_i (lambda/2) s_i^2 dV + (viscous part), and its gradient
+ * dD/du_a = lambda dV sum_i s_i ds_i/du_a with ds_i/du_a = g_ia (i != a), -sum_j g_aj (i = a)
+ * gives the bulk term of (K-6) with P_i = lambda s_i of (K-7a).  Taken implicitly (backward
+ * Euler, u^{k+1}), its matrix is lambda sum_i D_i D_i^T, D_i = grad_u s_i (C Lambda C^T of
+ * methods.md §8): symmetric positive semi-definite, and it couples fluid particles a, b
+ * through every i within h_p of both, so that |x_a - x_b| < 2 h_p = h_v: the viscous term's
+ * reach, and the neighbour lists' (list_l0 = 3.5).  The sum over i runs over every particle,
+ * walls included: their s_i (K-7a) holds the fluid's unknown velocities and their own known
+ * ones (the latter go to the right-hand side).  The viscous term of (K-6),
+ * -2 mu (d+2) sum_j (u_ij.e_ij) e_ij w_v'_ij / r_ij, is c_aj e e^T (u_a - u_j) with
+ * c_aj = -2 mu (d+2) w_v'_ij / r_ij > 0: a symmetric positive semi-definite matrix V.  With
+ * rho0/dt I the system is SPD, one row per velocity component of a fluid particle (unknown
+ * d r + c for fluid particle r, component c).
+ *
+ * Energy (methods.md §8): the conservative part (elastic, body force) is explicit and the
+ * dissipative part implicit; over a step the elastic and potential energy change by the work
+ * of the forces at x^{k+1} on the displacement dt u^k (symplectic Euler), so E decreases
+ * only up to the step's O(dt^2) splitting error, which the dissipation outweighs in the
+ * tests (tests/unit/mph_test.c). */
+#include "models/fluid/mph.h"
+
+#include <complex.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "models/fluid.h"
+#include "models/transport.h"
+#include "mps/operators.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+/* ---- kernels ---------------------------------------------------------------------------- */
+
+/* 1 / (S h^d): S = pi / (6 l0^2) (2-D), 2 pi / (15 l0^3) (3-D) [KC], methods.md §8 */
+static double kernel_coefficient(int dim, double l0, double h)
+{
+    const double s = dim == 2 ? M_PI / 6.0 : 2.0 * M_PI / 15.0;
+    const double q = l0 / h;
+    return (dim == 2 ? q * q : q * q * q) / s;
+}
+
+double lub_mph_w(int dim, double l0, double h, double r)
+{
+    if (!(r < h)) return 0.0;
+    const double t = 1.0 - r / h;
+    return kernel_coefficient(dim, l0, h) * t * t;
+}
+
+double lub_mph_dw(int dim, double l0, double h, double r)
+{
+    if (!(r < h)) return 0.0;
+    return -2.0 * kernel_coefficient(dim, l0, h) * (1.0 - r / h) / h;
+}
+
+double lub_mph_n0(int dim, double l0)
+{
+    const double h = LUB_MPH_HP * l0;
+    const int k = (int)ceil(LUB_MPH_HP), kz = dim == 3 ? k : 0;
+    double n0 = 0.0;
+    for (int a = -k; a <= k; a++)
+        for (int b = -k; b <= k; b++)
+            for (int c = -kz; c <= kz; c++) {
+                const double r = l0 * sqrt((double)(a * a + b * b + c * c));
+                if (r > 0) n0 += lub_mph_w(dim, l0, h, r);
+            }
+    return n0;
+}
+
+double lub_mph_elastic_limit(int dim)
+{
+    /* longitudinal plane waves xi_j = xi exp(i k.x_j) on the lattice (l0 = 1): the elastic
+     * potential (kappa/2) sum_i (n_i - n0)^2 dV gives rho0 omega^2 = kappa |a(k)|^2 with
+     * dn_i = a(k).xi exp(i k.x_i); the explicit step is stable for omega dt < 2.  Scanned
+     * over the Brillouin zone in steps of pi/32 (2-D: max |a| 0.9977 at k = (pi/2, 0),
+     * limit 2.005; 3-D: 1.083, limit 1.85) */
+    const int nk = 64, kz = dim == 3 ? nk : 0;
+    const double h = LUB_MPH_HP;
+    double amax = 0;
+    for (int p = 0; p <= nk; p++)
+        for (int q = 0; q <= nk; q++)
+            for (int t = 0; t <= kz; t++) {
+                const double k[3] = {M_PI * p / nk, M_PI * (2.0 * q - nk) / nk,
+                                     dim == 3 ? M_PI * (2.0 * t - nk) / nk : 0.0};
+                double complex a[3] = {0, 0, 0};
+                for (int x = -2; x <= 2; x++)
+                    for (int y = -2; y <= 2; y++)
+                        for (int z = dim == 3 ? -2 : 0; z <= (dim == 3 ? 2 : 0); z++) {
+                            const double r = sqrt((double)(x * x + y * y + z * z));
+                            if (!(r > 0 && r < h)) continue;
+                            const double dw = lub_mph_dw(dim, 1.0, h, r);
+                            const double complex ph =
+                                cexp(I * (k[0] * x + k[1] * y + k[2] * z)) - 1.0;
+                            a[0] += dw * x / r * ph;
+                            a[1] += dw * y / r * ph;
+                            a[2] += dw * z / r * ph;
+                        }
+                const double v =
+                    sqrt(creal(a[0] * conj(a[0]) + a[1] * conj(a[1]) + a[2] * conj(a[2])));
+                if (v > amax) amax = v;
+            }
+    return 2.0 / amax;
+}
+
+/* ---- the formulation's state ------------------------------------------------------------ */
+
+typedef struct {
+    size_t cap;    /* particles the arrays hold (lub_mps.cap) */
+    double hp, hv; /* kernel radii [m] */
+    double n0;
+    double *pk;        /* P^kap_i */
+    double *s;         /* s_i = sum_j u_ij.g_ij */
+    double *G[3];      /* sum_j g_ij */
+    double *rhs, *sol; /* d cap */
+    int *pos;          /* cap: the column block of a particle in the row being assembled, -1 */
+    int *blkp;         /* the particles of the column blocks of that row */
+    double *blk;       /* their d x d blocks */
+    size_t blk_cap;    /* blocks they hold (grown with the lists, rarely after the first steps) */
+    size_t nfar;       /* bulk pairs (a, b) beyond the lists (none expected; counted) */
+    double *pload;     /* the particle field pLoad (wall particles; see wall_load) */
+} mph_state;
+
+static void state_free(void *p)
+{
+    mph_state *S = p;
+    if (!S) return;
+    free(S->pk);
+    free(S->s);
+    for (int d = 0; d < 3; d++) free(S->G[d]);
+    free(S->rhs);
+    free(S->sol);
+    free(S->pos);
+    free(S->blkp);
+    free(S->blk);
+    free(S);
+}
+
+/* The state, allocated at the first step for the solver's capacity (lub_mps_init). */
+static mph_state *state(lub_mps *m)
+{
+    if (m->fstate) return m->fstate;
+    mph_state *S = lub_calloc(1, sizeof *S);
+    const size_t n = m->cap ? m->cap : 1;
+    S->cap = n;
+    S->hp = LUB_MPH_HP * m->l0;
+    S->hv = LUB_MPH_HV * m->l0;
+    S->n0 = lub_mph_n0(m->dim, m->l0);
+    S->pk = lub_calloc(n, sizeof(double));
+    S->s = lub_calloc(n, sizeof(double));
+    for (int d = 0; d < 3; d++) S->G[d] = lub_calloc(n, sizeof(double));
+    S->rhs = lub_calloc(3 * n, sizeof(double));
+    S->sol = lub_calloc(3 * n, sizeof(double));
+    S->pos = lub_malloc(n * sizeof(int));
+    for (size_t i = 0; i < n; i++) S->pos[i] = -1;
+    S->pload = lub_particles_extra(m->P, "pLoad");
+    m->fstate = S;
+    m->fstate_free = state_free;
+    if (m->c.list_l0 < LUB_MPH_HV)
+        lub_bug("mph: the neighbour lists reach %g l0, the viscosity kernel %g l0", m->c.list_l0,
+                LUB_MPH_HV);
+    return S;
+}
+
+/* ---- the step's parts ------------------------------------------------------------------- */
+
+/* Lists of every particle (walls and dummies carry n_i and P_i too), at the current
+ * positions; rebuild: from scratch, else updated while the skin allows. */
+static void neighbours(lub_mps *m, int rebuild)
+{
+    lub_particles *P = m->P;
+    double *x[3] = {P->x[0], P->x[1], P->x[2]};
+    lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
+    m->nb.list_kind = NULL;
+    if (!rebuild && lub_neighbours_update(&m->nb, x) != 0) rebuild = 1;
+    if (rebuild) {
+        lub_neighbours_build(&m->nb, P->n, x);
+        m->st.nrebuild++;
+    }
+    lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
+}
+
+static double pair_r(const lub_neighbours *nb, size_t q, int dim, double e[3])
+{
+    double r2 = 0;
+    for (int d = 0; d < dim; d++) r2 += nb->dx[d][q] * nb->dx[d][q];
+    const double r = sqrt(r2);
+    for (int d = 0; d < 3; d++) e[d] = d < dim && r > 0 ? nb->dx[d][q] / r : 0.0;
+    return r;
+}
+
+/* n_i, G_i = sum_j g_ij and P^kap_i = kappa max(n_i - n0, 0) of every particle (step 3). */
+static void density(lub_mps *m, mph_state *S)
+{
+    const lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    const int dim = m->dim;
+    const double kappa = m->c.bulk_modulus, l0 = m->l0;
+#pragma omp parallel for schedule(static) if (P->n >= LUB_LINALG_OMP_MIN)
+    for (size_t i = 0; i < P->n; i++) {
+        double n = 0, G[3] = {0, 0, 0};
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+            double e[3];
+            const double r = pair_r(nb, q, dim, e);
+            if (!(r < S->hp) || r == 0) continue;
+            n += lub_mph_w(dim, l0, S->hp, r);
+            const double dw = lub_mph_dw(dim, l0, S->hp, r);
+            for (int d = 0; d < dim; d++) G[d] += e[d] * dw;
+        }
+        m->pnd[i] = n;
+        for (int d = 0; d < 3; d++) S->G[d][i] = G[d];
+        S->pk[i] = kappa * fmax(n - S->n0, 0.0);
+    }
+}
+
+/* s_i = sum_j u_ij.g_ij of every particle, at the current velocities. */
+static void divergence(lub_mps *m, mph_state *S, double *s)
+{
+    const lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    const int dim = m->dim;
+#pragma omp parallel for schedule(static) if (P->n >= LUB_LINALG_OMP_MIN)
+    for (size_t i = 0; i < P->n; i++) {
+        double v = 0;
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+            double e[3];
+            const double r = pair_r(nb, q, dim, e);
+            if (!(r < S->hp) || r == 0) continue;
+            const size_t j = nb->j[q];
+            const double dw = lub_mph_dw(dim, m->l0, S->hp, r);
+            for (int d = 0; d < dim; d++) v += (P->u[d][j] - P->u[d][i]) * e[d] * dw;
+        }
+        s[i] = v;
+    }
+}
+
+/* Step 5: assemble the SPD system of the fluid velocities (see the top of the file) into
+ * m->A and S->rhs, u* in m->us.  Serial: the bulk term scatters into the blocks of a row
+ * through S->pos. */
+static int assemble(lub_mps *m, mph_state *S, double dt)
+{
+    const lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    const int dim = m->dim, dd = dim * dim;
+    const double rho = m->c.rho, mu = m->c.rho * m->c.nu, lam = m->c.bulk_viscosity;
+    const double l0 = m->l0;
+    int nf = 0;
+    for (size_t i = 0; i < P->n; i++) {
+        m->row[i] = P->kind[i] == LUB_FLUID ? nf : -1;
+        if (P->kind[i] == LUB_FLUID) m->prow[nf++] = (int)i;
+    }
+    /* pass 1: a fluid particle's rows hold the blocks of itself and of its fluid neighbours */
+    lub_csr_begin(&m->A, dim * nf);
+    size_t most = 0;
+    for (int r = 0; r < nf; r++) {
+        const size_t i = (size_t)m->prow[r];
+        size_t k = 1;
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) k += P->kind[nb->j[q]] == LUB_FLUID;
+        if (k > most) most = k;
+        for (int c = 0; c < dim; c++) lub_csr_set_row_length(&m->A, dim * r + c, dim * (int)k);
+    }
+    lub_csr_alloc(&m->A);
+    if (most > S->blk_cap) {
+        free(S->blkp);
+        free(S->blk);
+        S->blk_cap = most + most / 4;
+        S->blkp = lub_malloc(S->blk_cap * sizeof *S->blkp);
+        S->blk = lub_malloc(S->blk_cap * 9 * sizeof *S->blk);
+    }
+    const double visc = -2.0 * mu * (dim + 2);
+    for (int r = 0; r < nf; r++) {
+        const size_t a = (size_t)m->prow[r];
+        int nk = 0;
+        S->pos[a] = nk, S->blkp[nk++] = (int)a;
+        for (size_t q = nb->start[a]; q < nb->end[a]; q++) {
+            const size_t j = nb->j[q];
+            if (P->kind[j] == LUB_FLUID) S->pos[j] = nk, S->blkp[nk++] = (int)j;
+        }
+        memset(S->blk, 0, (size_t)nk * 9 * sizeof *S->blk);
+        double *B0 = S->blk, rhs[3];
+        for (int c = 0; c < dim; c++) {
+            B0[c * dim + c] = rho / dt;
+            rhs[c] = rho / dt * m->us[c][a];
+        }
+        /* viscous term c_aj e e^T (u_a - u_j), and the elastic pair forces
+         * (P^kap_a + P^kap_j) g_aj, explicit */
+        for (size_t q = nb->start[a]; q < nb->end[a]; q++) {
+            double e[3];
+            const double rr = pair_r(nb, q, dim, e);
+            if (!(rr < S->hv) || rr == 0) continue;
+            const size_t j = nb->j[q];
+            const double cv = visc * lub_mph_dw(dim, l0, S->hv, rr) / rr;
+            double *Bj = P->kind[j] == LUB_FLUID ? S->blk + (size_t)S->pos[j] * dd : NULL;
+            for (int c = 0; c < dim; c++)
+                for (int c2 = 0; c2 < dim; c2++) {
+                    const double v = cv * e[c] * e[c2];
+                    B0[c * dim + c2] += v;
+                    if (Bj)
+                        Bj[c * dim + c2] -= v;
+                    else
+                        rhs[c] += v * P->u[c2][j];
+                }
+            if (rr < S->hp) {
+                const double f = (S->pk[a] + S->pk[j]) * lub_mph_dw(dim, l0, S->hp, rr);
+                for (int c = 0; c < dim; c++) rhs[c] += f * e[c];
+            }
+        }
+        /* bulk viscosity: lambda sum_i D_ia D_ib^T over i = a and the particles within h_p */
+        if (lam > 0) {
+            for (size_t qa = nb->start[a]; qa <= nb->end[a]; qa++) {
+                size_t i;
+                double Dia[3] = {0, 0, 0};
+                if (qa == nb->end[a]) { /* i = a: D_aa = -G_a */
+                    i = a;
+                    for (int c = 0; c < dim; c++) Dia[c] = -S->G[c][a];
+                } else {
+                    double e[3];
+                    const double rr = pair_r(nb, qa, dim, e);
+                    if (!(rr < S->hp) || rr == 0) continue;
+                    i = nb->j[qa];
+                    /* D_ia = g_ia = e_ia w'(r), e_ia = -e_ai */
+                    const double dw = lub_mph_dw(dim, l0, S->hp, rr);
+                    for (int c = 0; c < dim; c++) Dia[c] = -e[c] * dw;
+                }
+                for (size_t qi = nb->start[i]; qi <= nb->end[i]; qi++) {
+                    size_t b;
+                    double Dib[3] = {0, 0, 0};
+                    if (qi == nb->end[i]) {
+                        b = i;
+                        for (int c = 0; c < dim; c++) Dib[c] = -S->G[c][i];
+                    } else {
+                        double e[3];
+                        const double rr = pair_r(nb, qi, dim, e);
+                        if (!(rr < S->hp) || rr == 0) continue;
+                        b = nb->j[qi];
+                        const double dw = lub_mph_dw(dim, l0, S->hp, rr);
+                        for (int c = 0; c < dim; c++) Dib[c] = e[c] * dw;
+                    }
+                    if (P->kind[b] == LUB_FLUID) {
+                        if (S->pos[b] < 0) { /* beyond the lists: cannot be (2 h_p = h_v) */
+                            S->nfar++;
+                            continue;
+                        }
+                        double *Bb = S->blk + (size_t)S->pos[b] * dd;
+                        for (int c = 0; c < dim; c++)
+                            for (int c2 = 0; c2 < dim; c2++)
+                                Bb[c * dim + c2] += lam * Dia[c] * Dib[c2];
+                    } else {
+                        double du = 0;
+                        for (int c = 0; c < dim; c++) du += Dib[c] * P->u[c][b];
+                        for (int c = 0; c < dim; c++) rhs[c] -= lam * Dia[c] * du;
+                    }
+                }
+            }
+        }
+        for (int c = 0; c < dim; c++) {
+            const int row = dim * r + c;
+            int *col = lub_csr_row_col(&m->A, row);
+            double *val = lub_csr_row_val(&m->A, row);
+            int e = 0;
+            for (int k = 0; k < nk; k++) {
+                const int cb = dim * m->row[S->blkp[k]];
+                for (int c2 = 0; c2 < dim; c2++) {
+                    col[e] = cb + c2;
+                    val[e++] = S->blk[(size_t)k * dd + c * dim + c2];
+                }
+            }
+            S->rhs[row] = rhs[c];
+            S->sol[row] = P->u[c][a]; /* initial guess: u^k */
+        }
+        for (int k = 0; k < nk; k++) S->pos[S->blkp[k]] = -1;
+    }
+    lub_csr_finish(&m->A);
+    return nf;
+}
+
+/* pLoad of the wall particles (kind wall): the wall-normal load per unit wall area of the
+ * pressure pair forces the fluid exerts on each, -n_i.sum_j (P_i + P_j) g_ij dV / l0^(d-1)
+ * over its fluid neighbours j (the force on i of the pair term of (K-6)), n_i the unit
+ * normal into the fluid, from the centroid of its wall and dummy neighbours within h_v to
+ * x_i.  Summed over a patch's wall particles (times l0^(d-1)) it is the load on the patch
+ * (the dummies' pairs with the fluid left out: none while the fluid keeps 1.75 l0 from
+ * them).  P_i of (K-7a) itself sees the fluid's compression on one side only and comes out
+ * near half the fluid's pressure at the wall (doc/methods.md §8). */
+static void wall_load(lub_mps *m, mph_state *S)
+{
+    const lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    const int dim = m->dim;
+    const double dV = dim == 2 ? m->l0 * m->l0 : m->l0 * m->l0 * m->l0;
+    const double area = dim == 2 ? m->l0 : m->l0 * m->l0;
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->kind[i] != LUB_WALL) {
+            S->pload[i] = 0.0;
+            continue;
+        }
+        double F[3] = {0, 0, 0}, c[3] = {0, 0, 0};
+        int nc = 0;
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+            double e[3];
+            const double r = pair_r(nb, q, dim, e);
+            if (!(r < S->hv) || r == 0) continue;
+            const size_t j = nb->j[q];
+            if (P->kind[j] != LUB_FLUID) {
+                for (int d = 0; d < dim; d++) c[d] += nb->dx[d][q];
+                nc++;
+            } else if (r < S->hp) {
+                const double f = (P->p[i] + P->p[j]) * lub_mph_dw(dim, m->l0, S->hp, r) * dV;
+                for (int d = 0; d < dim; d++) F[d] += f * e[d];
+            }
+        }
+        double nn = 0, fn = 0;
+        for (int d = 0; d < dim; d++) nn += c[d] * c[d];
+        nn = sqrt(nn);
+        if (nc && nn > 0)
+            for (int d = 0; d < dim; d++) fn += F[d] * -c[d] / nn;
+        S->pload[i] = -fn / area;
+    }
+}
+
+/* Wrap periodic coordinates into [lo, hi). */
+static void wrap(lub_mps *m)
+{
+    lub_particles *P = m->P;
+    for (int d = 0; d < m->dim; d++) {
+        if (!m->periodic[d]) continue;
+        const double lo = m->lo[d], L = m->hi[d] - m->lo[d];
+        double *x = P->x[d];
+        for (size_t i = 0; i < P->n; i++)
+            if (x[i] < lo || x[i] >= lo + L) {
+                x[i] = lo + fmod(x[i] - lo, L);
+                if (x[i] < lo) x[i] += L;
+                if (x[i] >= lo + L) x[i] -= L;
+            }
+    }
+}
+
+lub_step_status lub_mph_step(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize)
+{
+    lub_particles *P = m->P;
+    const size_t n = P->n;
+    const int dim = m->dim;
+    *bad = -1;
+    msg[0] = '\0';
+    memset(&m->st, 0, sizeof m->st);
+    if (n > m->cap) lub_bug("mph: %zu particles, the solver holds %zu", n, m->cap);
+    mph_state *S = state(m);
+
+    /* 1. x^{k+1} = x^k + dt u^k; walls and dummies move with their patch velocity (unless a
+     * model set it: patch_moved) */
+    lub_timer_start(&m->tm, LUB_T_OTHER);
+    for (size_t i = 0; i < n; i++)
+        if (P->kind[i] != LUB_FLUID && !m->c.patch_moved[P->patch[i]])
+            for (int d = 0; d < dim; d++) P->u[d][i] = m->c.patch_velocity[P->patch[i]][d];
+    for (int d = 0; d < dim; d++)
+        for (size_t i = 0; i < n; i++) P->x[d][i] += dt * P->u[d][i];
+    lub_timer_stop(&m->tm, LUB_T_OTHER);
+
+    /* 2. neighbours at x^{k+1}, built afresh (an update keeps only the pairs within re),
+     * the particles sorted first every reorderInterval steps (the global step: a restart
+     * sorts at the same steps); 3. n_i, P^kap */
+    if (m->c.reorder_interval > 0 && m->steps % m->c.reorder_interval == 0) {
+        lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
+        lub_mps_reorder(m);
+        lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
+    }
+    m->built = 1;
+    neighbours(m, 1);
+    lub_timer_start(&m->tm, LUB_T_ASSEMBLY);
+    density(m, S);
+
+    /* 4. u* = u^k + dt (F^s/m + g) (the configuration's and the models' body acceleration,
+     * the models' per-particle forces) */
+    double g[3] = {m->c.g[0], m->c.g[1], m->c.g[2]};
+    if (m->hooks.forces) m->hooks.forces(m->hooks.ctx, m, dt, g);
+    for (int d = 0; d < dim; d++)
+        for (size_t i = 0; i < n; i++)
+            m->us[d][i] = P->kind[i] == LUB_FLUID ? P->u[d][i] + dt * g[d] : P->u[d][i];
+    lub_mps_particle_forces(m, dt, m->us); /* F^s / m (surface tension), explicit */
+
+    /* 5. the velocities at k+1 */
+    const int nf = assemble(m, S, dt);
+    lub_timer_stop(&m->tm, LUB_T_ASSEMBLY);
+    lub_timer_start(&m->tm, LUB_T_VISCOSITY);
+    const double *b[1] = {S->rhs};
+    double *x[1] = {S->sol};
+    lub_solve_status st =
+        nf > 0 ? lub_linsolver_solve(&m->vsolver, &m->A, 1, b, x, m->st.v) : LUB_SOLVE_OK;
+    lub_timer_stop(&m->tm, LUB_T_VISCOSITY);
+    if (st != LUB_SOLVE_OK && !m->c.v_continue) {
+        char d[256];
+        lub_solve_result_describe(&m->st.v[0], d, sizeof d);
+        snprintf(msg, msgsize, "MPH velocity solve (%d unknowns) failed: %s", dim * nf, d);
+        return LUB_STEP_SOLVE_FAILED;
+    }
+    for (int r = 0; r < nf; r++)
+        for (int d = 0; d < dim; d++) P->u[d][m->prow[r]] = S->sol[dim * r + d];
+
+    /* 6. P_i = P^kap_i + lambda s_i (K-7a), every particle */
+    lub_timer_start(&m->tm, LUB_T_GRADIENT);
+    divergence(m, S, S->s);
+    for (size_t i = 0; i < n; i++) P->p[i] = S->pk[i] + m->c.bulk_viscosity * S->s[i];
+    wall_load(m, S);
+    lub_timer_stop(&m->tm, LUB_T_GRADIENT);
+
+    /* the models' corrections (collision), periodic wrap, checks */
+    if (m->hooks.after_correction) m->hooks.after_correction(m->hooks.ctx, m, dt);
+    lub_timer_start(&m->tm, LUB_T_OTHER);
+    wrap(m);
+    lub_step_status s = lub_mps_check(m, dt, bad, msg, msgsize);
+    m->st.umax = lub_mps_max_speed(m);
+    m->st.nunknowns = (size_t)(dim * nf);
+    lub_timer_stop(&m->tm, LUB_T_OTHER);
+    m->iterations[1] += m->st.v[0].iterations;
+    m->steps++;
+    return s;
+}
+
+void lub_mph_operators(lub_mps *m, double *pnd, double *div, double *const visc[3])
+{
+    mph_state *S = state(m);
+    const lub_particles *P = m->P;
+    const int dim = m->dim;
+    neighbours(m, 1);
+    m->built = 0; /* the next step builds its own */
+    density(m, S);
+    if (pnd) memcpy(pnd, m->pnd, P->n * sizeof *pnd);
+    if (div) divergence(m, S, div);
+    if (!visc) return;
+    const lub_neighbours *nb = &m->nb;
+    for (size_t i = 0; i < P->n; i++) {
+        double v[3] = {0, 0, 0};
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+            double e[3];
+            const double r = pair_r(nb, q, dim, e);
+            if (!(r < S->hv) || r == 0) continue;
+            const size_t j = nb->j[q];
+            double ue = 0;
+            for (int d = 0; d < dim; d++) ue += (P->u[d][j] - P->u[d][i]) * e[d];
+            const double f = -2.0 * (dim + 2) * ue * lub_mph_dw(dim, m->l0, S->hv, r) / r;
+            for (int d = 0; d < dim; d++) v[d] += f * e[d];
+        }
+        for (int d = 0; d < dim; d++) visc[d][i] = v[d];
+    }
+}
+
+double lub_mph_energy(const lub_mps *m, const double g[3], double dt, double part[4])
+{
+    const lub_particles *P = m->P;
+    const mph_state *S = m->fstate;
+    const lub_neighbours *nb = &m->nb;
+    const int dim = m->dim;
+    const double dV = dim == 2 ? m->l0 * m->l0 : m->l0 * m->l0 * m->l0;
+    const double mass = m->c.rho * dV;
+    double e[4] = {0, 0, 0, 0};
+    for (size_t i = 0; i < P->n; i++) {
+        if (S) {
+            const double dn = fmax(m->pnd[i] - S->n0, 0.0);
+            e[1] += 0.5 * m->c.bulk_modulus * dn * dn * dV;
+        }
+        if (P->kind[i] != LUB_FLUID) continue;
+        double F[3] = {mass * g[0], mass * g[1], mass * g[2]};
+        if (S)
+            for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+                double ev[3];
+                const double r = pair_r(nb, q, dim, ev);
+                if (!(r < S->hp) || r == 0) continue;
+                const double f = (S->pk[i] + S->pk[nb->j[q]]) * lub_mph_dw(dim, m->l0, S->hp, r);
+                for (int d = 0; d < dim; d++) F[d] += f * ev[d] * dV;
+            }
+        for (int d = 0; d < dim; d++) {
+            e[0] += 0.5 * mass * P->u[d][i] * P->u[d][i];
+            e[2] -= mass * g[d] * P->x[d][i];
+            e[3] -= 0.5 * dt * P->u[d][i] * F[d];
+        }
+    }
+    if (part)
+        for (int k = 0; k < 4; k++) part[k] = e[k];
+    return e[0] + e[1] + e[2] + e[3];
+}
+
+/* ---- the formulation (models/fluid.h) --------------------------------------------------- */
+
+static void mph_read(lub_mps_config *c, const lub_case *cs, lub_node *models, lub_node *entry)
+{
+    char path[LUB_PATH_MAX];
+    lub_mps_config_defaults(c);
+    lub_transport_read(lub_case_path(cs, path, "constant/transportProperties.yaml"), &c->rho,
+                       &c->nu);
+    /* fluid: { type: mph } is there (the type was read from it) */
+    c->bulk_viscosity = lub_dict_real(entry, "bulkViscosity", LUB_NONNEGATIVE);
+    c->bulk_modulus = lub_dict_real(entry, "bulkModulus", LUB_POSITIVE);
+    lub_node *v = lub_dict_find(models, "viscosity");
+    if (v)
+        lub_node_error(v, "'viscosity' belongs to the fluid 'mps'; the fluid 'mph' takes its "
+                          "shear viscosity mu = rho nu (constant/transportProperties.yaml) "
+                          "implicitly, always: remove the entry");
+    lub_node *mr = lub_dict_find(models, "multiResolution");
+    if (mr)
+        lub_node_error(mr, "the fluid 'mph' takes one resolution level: multiResolution couples "
+                           "levels of the fluid 'mps' (semi-implicit MPS) only");
+    lub_mps_config_read(c, cs->root);
+    /* MPH's own: lists to h_v, no pressure predictor nor clipping (the MPS pressure
+     * equation is not solved); its viscosity is implicit (lubFoam's diffusion-number check
+     * of implicit viscosity holds for it) */
+    c->list_l0 = LUB_MPH_HV;
+    c->predictor = 0.0;
+    c->clip_negative = LUB_NEGATIVE_KEEP;
+    c->viscosity = LUB_VISCOSITY_CN;
+}
+
+static void mph_header_level(const lub_mps *m)
+{
+    lub_message("MPH: l0 %g m, h_p %g m (1.75 l0), h_v %g m (3.5 l0), n0 %.10g; rho0 %g kg/m^3, "
+                "mu %g Pa s, bulkViscosity lambda %g Pa s, bulkModulus kappa %g Pa",
+                m->l0, LUB_MPH_HP * m->l0, LUB_MPH_HV * m->l0, lub_mph_n0(m->dim, m->l0), m->c.rho,
+                m->c.rho * m->c.nu, m->c.bulk_viscosity, m->c.bulk_modulus);
+}
+
+static void mph_header(const lub_mps *m)
+{
+    char vs[256];
+    lub_linsolver_describe(&m->vsolver, vs, sizeof vs);
+    lub_message("Schemes: MPH-I (x explicit, elastic term explicit, bulk and shear viscosity "
+                "backward Euler, all velocity components in one SPD system)");
+    lub_message("Solvers: U %s", vs);
+}
+
+/* The fluid's height along g: the extent of the fluid particles plus l0. */
+static double fluid_height(const lub_mps *m, const double g[3], double gn)
+{
+    const lub_particles *P = m->P;
+    double lo = INFINITY, hi = -INFINITY;
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->kind[i] != LUB_FLUID) continue;
+        double h = 0;
+        for (int d = 0; d < m->dim; d++) h -= g[d] * P->x[d][i] / gn;
+        lo = fmin(lo, h), hi = fmax(hi, h);
+    }
+    return hi >= lo ? hi - lo + m->l0 : 0.0;
+}
+
+static void mph_check(const lub_mps *m, const lub_geometry *geo, double dt, const double g[3])
+{
+    /* the elastic term is explicit (symplectic Euler): stable while the stiffest lattice
+     * compression wave has omega dt < 2 (lub_mph_elastic_limit: 2.00 in 2-D, 1.85 in 3-D);
+     * above 1 a compression wave crosses more than l0 per step (Kondo's samples run
+     * 0.2-1.6, methods.md §8) */
+    const double ce = dt * sqrt(m->c.bulk_modulus / m->c.rho) / m->l0;
+    const double lim = lub_mph_elastic_limit(m->dim);
+    lub_message("MPH: elastic number dt sqrt(kappa/rho0)/l0 %.4g (explicit; stable below %.3g, "
+                "resolved below 1)",
+                ce, lim);
+    if (!(ce < lim))
+        lub_fatal("MPH: the elastic number dt sqrt(kappa/rho0)/l0 = %.4g (deltaT %g s, "
+                  "bulkModulus %g Pa, rho %g kg/m^3, l0 %g m) is beyond the stability limit "
+                  "%.3g of its explicit step: reduce deltaT to at most %.4g s or bulkModulus "
+                  "(constant/models.yaml fluid)",
+                  ce, dt, m->c.bulk_modulus, m->c.rho, m->l0, lim,
+                  0.9 * lim * m->l0 / sqrt(m->c.bulk_modulus / m->c.rho));
+    if (ce > 1)
+        lub_warning("MPH: the elastic number dt sqrt(kappa/rho0)/l0 = %.4g is above 1: a "
+                    "compression wave crosses more than l0 per step (stable up to %.3g)",
+                    ce, lim);
+    double gn = 0;
+    for (int d = 0; d < m->dim; d++) gn += g[d] * g[d];
+    gn = sqrt(gn);
+    if (gn > 0) {
+        const double H = fluid_height(m, g, gn);
+        const double comp = m->c.rho * gn * H / m->c.bulk_modulus;
+        lub_message("MPH: hydrostatic compression rho0 |g| H / kappa %.3g (H %g m, the fluid's "
+                    "height along g; keep below 1e-2)",
+                    comp, H);
+        if (comp > 1e-2)
+            lub_warning("MPH: the hydrostatic compression rho0 |g| H / kappa = %.3g is above "
+                        "1e-2: kappa carries the weight by compressing the fluid by that "
+                        "fraction; raise bulkModulus (and lower deltaT with it)",
+                        comp);
+    }
+    lub_message("MPH: free surfaces need no condition (P^kap = 0 where n_i < n0; tension only "
+                "through -lambda div u)");
+    /* walls: h_v = 3.5 l0 thick, a wall layer and three dummy layers (a fluid particle l0/2
+     * in front of the wall layer sees 3 l0 behind it) */
+    if (geo && geo->nwalls > 0 && geo->dummy_layers < 3) {
+        const lub_node *root = lub_dict_root(geo->dict);
+        const lub_node *dl = lub_dict_find((lub_node *)root, "dummyLayers");
+        const char *why = "the fluid 'mph' (constant/models.yaml) needs walls one viscosity "
+                          "kernel radius h_v = 3.5 l0 thick: a wall layer and at least 3 dummy "
+                          "layers (dummyLayers: 3), then run particleGen";
+        if (dl) lub_node_error(dl, "dummyLayers: %d: %s", geo->dummy_layers, why);
+        lub_node_error(lub_dict_find((lub_node *)root, "walls"), "no dummyLayers (default 2): %s",
+                       why);
+    }
+}
+
+static void mph_log(const lub_mps *m, double dt, double pit, char *buf, size_t size)
+{
+    (void)dt, (void)pit;
+    snprintf(buf, size, "U %3d it %8.2e  ", m->st.v[0].iterations, m->st.v[0].residual);
+}
+
+const lub_fluid_type lub_fluid_mph = {
+    .name = "mph",
+    .read = mph_read,
+    .step = lub_mph_step,
+    .header_level = mph_header_level,
+    .header = mph_header,
+    .check = mph_check,
+    .log = mph_log,
+};

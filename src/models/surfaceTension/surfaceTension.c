@@ -1,0 +1,363 @@
+/* lubkit model surfaceTension: the two-potential surface tension (CPP + DGP) of Kondo and
+ * Matsumoto, with wetting (doc/methods.md §9).
+ *
+ *     surfaceTension: { sigma: 0.03, contactAngle: { lowerWall: 30, upperWall: 90 } }
+ *     surfaceTension: { sigma: 0.03, wallFactor: { lowerWall: 0.5 } }    # c itself
+ *
+ * sigma [N/m]; contactAngle [degrees] per wall patch (a patch not listed: 90).  The surface
+ * potential (K-7b) of every particle, fluid, wall and dummy,
+ *
+ *     V = a sum_i ( (1/2) min(n^a_i - n0^a, 0)^2 + (k^2/2) |chi_i|^2 ) dA,
+ *     n^a_i = sum_j c_ij w^a_ij,   chi_i = (h_s / R2) sum_j c_ij r_ij w^g_ij,
+ *
+ * with c_ij = 1 between particles of one kind (fluid-fluid, wall-wall) and c = c(theta) of
+ * the wall's patch between fluid and wall, gives the force F^s_a = -dV/dx_a on each fluid
+ * particle (K-8, derived here from V; the walls do not move):
+ *
+ *     F^s_a = a dA sum_j c_aj (N_a + N_j) e_aj w^a'_aj
+ *             - a k^2 (h_s/R2) dA sum_j c_aj M_aj (chi_j - chi_a),
+ *     N_i = min(n^a_i - n0^a, 0),   M_aj v = w^g_aj v + (v.r_aj) e_aj w^g'_aj,
+ *
+ * a pair force antisymmetric between fluid particles, so that the fluid's momentum is kept
+ * (its angular momentum too: V is invariant under rotation).  The wall particles carry the
+ * potential too: a bare wall has the deficit of a free surface (sigma per area), which the
+ * fluid covering it removes in part (c = 1: the wall acts as fluid, sigma_SL = 0, complete
+ * wetting; c = 0: sigma_SL = 2 sigma, theta = 180 degrees); without it the wall could only
+ * add energy and every angle would be 90 degrees or more.  The walls' own part of n^a and
+ * chi (their wall and dummy neighbours) is formed once, at the first step, and kept: walls
+ * at rest or translating rigidly (not an elastic wall).  Kernels: w^a = (r/h)(1 -
+ * r/h)^2 / (S_a h^d), S_a = pi/(15 l0^d); w^g the MPH kernel (models/fluid/mph.h);
+ * h = h_s = 3.5 l0; R2 = h^2/10 (2-D), 2 h^2/21 (3-D); k = 0.350778153 (2-D), 0.326976006
+ * (3-D); a = sigma / (h_s (I_N + k^2 I_X)), I_N = 0.024679383, I_X = 0.226126699 (2-D),
+ * 0.021425779, 0.233977488 (3-D): Kondo's flat-interface calibration [KC].
+ *
+ * The wall factor c(theta): Young-Dupre's (1 + cos theta)/2 for pairwise-additive energies
+ * does not hold (CPP is quadratic in the density deficit); c is interpolated in the table
+ * of angles measured on 2-D sessile drops (doc/methods.md §9, tests/bench/sessile_bench.c).
+ *
+ * The particle field pCohesive = a N_i is the cohesive pressure: CPP's pair term has the form
+ * of (K-6)'s pressure term with a N_i for P_i, and where the fluid is stretched (n^a < n0^a
+ * in the bulk: a liquid bridge, a film in tension) it carries the tension, while P of
+ * (K-7a) stays near 0 (its elastic part is compression-only).  P + pCohesive is the
+ * pressure to compare with -2 sigma cos(theta)/H (doc/methods.md §9).
+ *
+ * Both fluids call it with the explicit forces (particle_forces, models/model.h); the lists
+ * must reach h_s = 3.5 l0 (configure: list_l0). */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "models/fluid/mph.h"
+#include "models/model.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+#define HS 3.5 /* h_s / l0 */
+
+typedef struct {
+    double sigma;
+    double theta[LUB_MAX_PATCHES]; /* degrees */
+    double c[LUB_MAX_PATCHES];     /* wall factor per patch */
+    int dim;
+    double l0, hs, a, k, R2, n0a;
+    size_t cap;
+    double *na, *chi[3];
+    double *pc;            /* the particle field pCohesive: a N_i, the cohesive (CPP) pressure */
+    int walls_done;        /* the walls' own parts formed */
+    double *naw, *chiw[3]; /* the walls' own n^a and chi (wall and dummy particles) */
+} surface;
+
+/* w^a(r, h) = (r/h)(1 - r/h)^2 / (S_a h^d), S_a = pi/(15 l0^d); l0^-d int w^a dV = 1 */
+static double wa(int dim, double l0, double h, double r)
+{
+    if (!(r < h)) return 0.0;
+    const double q = r / h, lh = l0 / h;
+    return q * (1 - q) * (1 - q) * (dim == 2 ? lh * lh : lh * lh * lh) * 15.0 / M_PI;
+}
+
+static double dwa(int dim, double l0, double h, double r)
+{
+    if (!(r < h)) return 0.0;
+    const double q = r / h, lh = l0 / h;
+    return (1 - q) * (1 - 3 * q) / h * (dim == 2 ? lh * lh : lh * lh * lh) * 15.0 / M_PI;
+}
+
+static double pair(const lub_neighbours *nb, size_t q, int dim, double e[3])
+{
+    double r2 = 0;
+    for (int d = 0; d < dim; d++) r2 += nb->dx[d][q] * nb->dx[d][q];
+    const double r = sqrt(r2);
+    for (int d = 0; d < 3; d++) e[d] = d < dim && r > 0 ? nb->dx[d][q] / r : 0.0;
+    return r;
+}
+
+/* The contact angle of a 2-D sessile drop against the wall factor c (doc/methods.md §9:
+ * build/bench/sessile_bench, the longest run of each c: 0.1 s for 0.05, 0.25, 0.35, 0.2 s
+ * for 0.15, 0.5, 0.4 s for 0.6, 0.75, 0.85), the angle decreasing. */
+static const double table_c[] = {0.05, 0.15, 0.25, 0.35, 0.5, 0.6, 0.75, 0.85};
+static const double table_theta[] = {143.3, 110.6, 91.6, 78.6, 63.1, 50.0, 37.2, 28.5};
+#define TABLE_N (sizeof table_c / sizeof *table_c)
+
+/* c for the angle theta (degrees) by linear interpolation in the table; -1 outside it. */
+static double wall_factor(double theta)
+{
+    for (size_t k = 0; k + 1 < TABLE_N; k++) {
+        const double t0 = table_theta[k], t1 = table_theta[k + 1];
+        if (theta <= t0 && theta >= t1)
+            return table_c[k] + (table_c[k + 1] - table_c[k]) * (theta - t0) / (t1 - t0);
+    }
+    return -1.0;
+}
+
+/* The patch of a key of map (contactAngle, wallFactor), fatal with file:line if none. */
+static int patch_of(lub_scene *s, lub_node *map, const char *name)
+{
+    const int p = lub_particles_find_patch(s->P, name);
+    if (p >= 0) return p;
+    const char *names[LUB_MAX_PATCHES];
+    for (int q = 0; q < s->P->npatches; q++) names[q] = s->P->patch_names[q];
+    const char *near = lub_closest(name, names, (size_t)s->P->npatches);
+    lub_node_error(lub_dict_get(map, name),
+                   "surfaceTension: the particles have no wall patch '%s'%s%s%s", name,
+                   near ? " (did you mean '" : "", near ? near : "", near ? "'?)" : "");
+}
+
+static void st_read(lub_model *m, lub_scene *s)
+{
+    surface *S = m->state;
+    lub_node_expect_map(m->entry);
+    S->sigma = lub_dict_real(m->entry, "sigma", LUB_NONNEGATIVE);
+    for (int p = 0; p < LUB_MAX_PATCHES; p++) S->theta[p] = 90.0;
+    lub_node *ca = lub_dict_map_or(m->entry, "contactAngle");
+    for (size_t k = 0; ca && k < lub_node_size(ca); k++) {
+        const char *name = lub_node_key_at(ca, k);
+        const int p = patch_of(s, ca, name);
+        S->theta[p] = lub_dict_real(ca, name, LUB_BETWEEN(0.0, 180.0));
+        if (wall_factor(S->theta[p]) < 0)
+            lub_node_error(lub_dict_get(ca, name),
+                           "surfaceTension: contactAngle %g degrees for '%s' is outside the "
+                           "measured table of the wall factor, %g to %g degrees (methods.md 9)",
+                           S->theta[p], name, table_theta[TABLE_N - 1], table_theta[0]);
+    }
+    for (int p = 0; p < LUB_MAX_PATCHES; p++) S->c[p] = wall_factor(S->theta[p]);
+    /* wallFactor: c itself, for a patch not in contactAngle (the calibration runs) */
+    lub_node *wf = lub_dict_map_or(m->entry, "wallFactor");
+    for (size_t k = 0; wf && k < lub_node_size(wf); k++) {
+        const char *name = lub_node_key_at(wf, k);
+        const int p = patch_of(s, wf, name);
+        if (ca && lub_dict_find(ca, name))
+            lub_node_error(lub_dict_get(wf, name),
+                           "surfaceTension: patch '%s' has a contactAngle and a wallFactor: give "
+                           "one",
+                           name);
+        S->c[p] = lub_dict_real(wf, name, LUB_BETWEEN(0.0, 1.0));
+        S->theta[p] = NAN;
+    }
+    S->dim = s->P->dim;
+    S->l0 = s->P->levels[0].l0;
+}
+
+static void st_check(lub_model *m, lub_scene *s)
+{
+    if (strcmp(s->fluid->name, "mps") == 0)
+        lub_warning("%s: surfaceTension with the fluid 'mps': MPS holds p = 0 on its free-surface "
+                    "particles, within the layer where the cohesive forces act, so the Laplace "
+                    "pressure does not build; a 2-D drop contracts until it has no surface "
+                    "particle left (methods.md 9).  The fluid 'mph' carries it",
+                    s->models_path);
+    if (s->P->nlevels > 1 || lub_dict_find(lub_dict_root(s->dict), "multiResolution"))
+        lub_node_error(m->entry, "surfaceTension: one resolution level only (not with "
+                                 "multiResolution)");
+}
+
+static void st_configure(lub_model *m, lub_scene *s, lub_mps_config *c)
+{
+    (void)m, (void)s;
+    if (c->list_l0 < HS) c->list_l0 = HS; /* the kernels reach h_s */
+}
+
+static void st_init(lub_model *m, lub_scene *s)
+{
+    surface *S = m->state;
+    const int dim = S->dim;
+    const double l0 = S->l0;
+    S->hs = HS * l0;
+    S->k = dim == 2 ? 0.350778153 : 0.326976006;
+    const double IN = dim == 2 ? 0.024679383 : 0.021425779;
+    const double IX = dim == 2 ? 0.226126699 : 0.233977488;
+    S->a = S->sigma / (S->hs * (IN + S->k * S->k * IX));
+    S->R2 = dim == 2 ? S->hs * S->hs / 10.0 : 2.0 * S->hs * S->hs / 21.0;
+    /* n0^a on the lattice */
+    const int h = (int)ceil(HS), hz = dim == 3 ? h : 0;
+    S->n0a = 0;
+    for (int x = -h; x <= h; x++)
+        for (int y = -h; y <= h; y++)
+            for (int z = -hz; z <= hz; z++) {
+                const double r = l0 * sqrt((double)(x * x + y * y + z * z));
+                if (r > 0) S->n0a += wa(dim, l0, S->hs, r);
+            }
+    S->cap = s->P->cap > s->P->n ? s->P->cap : s->P->n;
+    S->na = lub_calloc(S->cap ? S->cap : 1, sizeof(double));
+    for (int d = 0; d < 3; d++) S->chi[d] = lub_calloc(S->cap ? S->cap : 1, sizeof(double));
+    S->naw = lub_calloc(S->cap ? S->cap : 1, sizeof(double));
+    S->pc = lub_particles_extra(s->P, "pCohesive");
+    for (int d = 0; d < 3; d++) S->chiw[d] = lub_calloc(S->cap ? S->cap : 1, sizeof(double));
+}
+
+/* The walls' own n^a and chi from their wall and dummy neighbours, by a search of their own
+ * (the fluid's lists leave out the dummies' lists in MPS): once, at the first step. */
+static void walls_own(surface *S, const lub_mps *f)
+{
+    const lub_particles *P = f->P;
+    const int dim = S->dim;
+    size_t nw = 0;
+    for (size_t i = 0; i < P->n; i++) nw += P->kind[i] != LUB_FLUID;
+    S->walls_done = 1;
+    if (!nw) return;
+    double *x[3] = {NULL, NULL, NULL};
+    size_t *idx = lub_malloc(nw * sizeof *idx);
+    for (int d = 0; d < dim; d++) x[d] = lub_malloc(nw * sizeof(double));
+    nw = 0;
+    for (size_t i = 0; i < P->n; i++)
+        if (P->kind[i] != LUB_FLUID) {
+            for (int d = 0; d < dim; d++) x[d][nw] = P->x[d][i];
+            idx[nw++] = i;
+        }
+    lub_neighbours nb;
+    lub_neighbours_init(&nb, dim, S->hs, 0.0, f->lo, f->hi, f->periodic);
+    lub_neighbours_build(&nb, nw, x);
+    for (size_t k = 0; k < nw; k++) {
+        const size_t i = idx[k];
+        double n = 0, chi[3] = {0, 0, 0};
+        for (size_t q = nb.start[k]; q < nb.end[k]; q++) {
+            double e[3];
+            const double r = pair(&nb, q, dim, e);
+            if (!(r < S->hs) || r == 0) continue;
+            n += wa(dim, S->l0, S->hs, r);
+            const double wg = lub_mph_w(dim, S->l0, S->hs, r);
+            for (int d = 0; d < dim; d++) chi[d] += nb.dx[d][q] * wg;
+        }
+        S->naw[i] = n;
+        for (int d = 0; d < dim; d++) S->chiw[d][i] = chi[d];
+    }
+    lub_neighbours_free(&nb);
+    free(idx);
+    for (int d = 0; d < dim; d++) free(x[d]);
+}
+
+static int st_particle_forces(lub_model *m, const lub_mps *f, double *const acc[3])
+{
+    surface *S = m->state;
+    const lub_particles *P = f->P;
+    const lub_neighbours *nb = &f->nb;
+    const int dim = S->dim;
+    const double l0 = S->l0, hs = S->hs;
+    if (P->n > S->cap) lub_bug("surfaceTension: %zu particles, %zu allocated", P->n, S->cap);
+    if (S->sigma == 0) return 0;
+    if (!S->walls_done) walls_own(S, f);
+    const double ch = hs / S->R2;
+    /* n^a and chi: the walls' own part, then every fluid particle's pairs (its own sums, and
+     * its share of its wall neighbours', c w) */
+    for (size_t i = 0; i < P->n; i++) {
+        const int fl = P->kind[i] == LUB_FLUID;
+        S->na[i] = fl ? 0.0 : S->naw[i];
+        for (int d = 0; d < 3; d++) S->chi[d][i] = fl || d >= dim ? 0.0 : S->chiw[d][i];
+    }
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->kind[i] != LUB_FLUID) continue;
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+            double e[3];
+            const double r = pair(nb, q, dim, e);
+            if (!(r < hs) || r == 0) continue;
+            const size_t j = nb->j[q];
+            const int fl = P->kind[j] == LUB_FLUID;
+            const double c = fl ? 1.0 : S->c[P->patch[j]];
+            const double w = c * wa(dim, l0, hs, r), wg = c * lub_mph_w(dim, l0, hs, r);
+            S->na[i] += w;
+            for (int d = 0; d < dim; d++) S->chi[d][i] += nb->dx[d][q] * wg;
+            if (!fl) { /* the wall particle's share: r_ji = -r_ij */
+                S->na[j] += w;
+                for (int d = 0; d < dim; d++) S->chi[d][j] -= nb->dx[d][q] * wg;
+            }
+        }
+    }
+    for (size_t i = 0; i < P->n; i++) {
+        S->na[i] = fmin(S->na[i] - S->n0a, 0.0); /* N_i: CPP only where n^a < n0^a */
+        S->pc[i] = S->a * S->na[i];
+        for (int d = 0; d < dim; d++) S->chi[d][i] *= ch;
+    }
+    const double dA = dim == 2 ? l0 * l0 : l0 * l0 * l0;
+    const double inv_m = 1.0 / (f->c.rho * dA), ak2 = S->a * S->k * S->k * ch;
+    for (size_t a = 0; a < P->n; a++) {
+        if (P->kind[a] != LUB_FLUID) continue;
+        double F[3] = {0, 0, 0};
+        for (size_t q = nb->start[a]; q < nb->end[a]; q++) {
+            double e[3];
+            const double r = pair(nb, q, dim, e);
+            if (!(r < hs) || r == 0) continue;
+            const size_t j = nb->j[q];
+            const double c = P->kind[j] == LUB_FLUID ? 1.0 : S->c[P->patch[j]];
+            /* CPP: c (N_a + N_j) e w^a' */
+            const double cpp = S->a * c * (S->na[a] + S->na[j]) * dwa(dim, l0, hs, r);
+            /* DGP: c M_aj (chi_j - chi_a), M v = w v + (v.r) e w' */
+            double v[3] = {0, 0, 0}, vr = 0;
+            for (int d = 0; d < dim; d++) {
+                v[d] = S->chi[d][j] - S->chi[d][a];
+                vr += v[d] * nb->dx[d][q];
+            }
+            const double wg = lub_mph_w(dim, l0, hs, r), dwg = lub_mph_dw(dim, l0, hs, r);
+            for (int d = 0; d < dim; d++)
+                F[d] += cpp * e[d] - ak2 * c * (wg * v[d] + vr * e[d] * dwg);
+        }
+        for (int d = 0; d < dim; d++) acc[d][a] += F[d] * dA * inv_m;
+    }
+    return 1;
+}
+
+static void st_describe(const lub_model *m, const lub_scene *s, char *buf, size_t size)
+{
+    (void)s;
+    const surface *S = m->state;
+    snprintf(buf, size, "surfaceTension (sigma %g N/m)", S->sigma);
+}
+
+static void st_header(const lub_model *m, const lub_scene *s)
+{
+    const surface *S = m->state;
+    char walls[1024] = "";
+    size_t len = 0;
+    for (int p = 0; p < s->P->npatches && len < sizeof walls; p++)
+        len += isnan(S->theta[p])
+                   ? (size_t)snprintf(walls + len, sizeof walls - len, "%s%s c %.4g",
+                                      len ? ", " : "", s->P->patch_names[p], S->c[p])
+                   : (size_t)snprintf(walls + len, sizeof walls - len, "%s%s %g deg (c %.4g)",
+                                      len ? ", " : "", s->P->patch_names[p], S->theta[p], S->c[p]);
+    lub_message("surfaceTension: CPP + DGP (methods.md 9), sigma %g N/m, h_s %g m (3.5 l0), "
+                "a %.6g Pa, k %.9g, n0^a %.10g; walls: %s (c from the sessile-drop table)",
+                S->sigma, S->hs, S->a, S->k, S->n0a, len ? walls : "none");
+}
+
+static void st_free(lub_model *m)
+{
+    surface *S = m->state;
+    free(S->na);
+    free(S->naw);
+    for (int d = 0; d < 3; d++) free(S->chi[d]), free(S->chiw[d]);
+}
+
+const lub_model_type lub_model_surfaceTension = {
+    .name = "surfaceTension",
+    .size = sizeof(surface),
+    .read = st_read,
+    .check = st_check,
+    .configure = st_configure,
+    .init = st_init,
+    .describe = st_describe,
+    .header = st_header,
+    .particle_forces = st_particle_forces,
+    .free = st_free,
+};
