@@ -93,7 +93,10 @@ typedef struct lub_model_type {
     int (*forces)(lub_model *m, const lub_mps *f, double dt, double acc[3]);
     /* inside the step of each level's solver f: add the acceleration of forces that depend on
      * the particles (surface tension) to acc[d][i] of the fluid particles; 1 if it added
-     * any (mps.h lub_mps_hooks.particle_forces) */
+     * any (mps.h lub_mps_hooks.particle_forces).  A pair force's reaction on a wall or
+     * dummy particle goes to its acc[d][i] too, in the same units (force over a fluid
+     * particle's mass rho l0^d): the step ignores it, a body's force takes it (fluid/mph.c
+     * wall_forces) */
     int (*particle_forces)(lub_model *m, const lub_mps *f, double *const acc[3]);
     void (*after_correction)(lub_model *m, lub_mps *f, double dt);
     lub_step_status (*advance)(lub_model *m, lub_scene *s, double dt, long *bad, char *msg,

@@ -233,7 +233,8 @@ struct lub_mps {
     int built;  /* neighbour lists built once */
 
     double *pacc[3]; /* hooks.particle_forces' accelerations (allocated at the first step
-                        that has the hook) */
+                        that has the hook); on wall and dummy particles the reactions of the
+                        pair forces, kept until the next step (models/model.h) */
     /* a formulation's own work arrays (models/fluid.h; NULL for mps), freed by
      * lub_mps_free with fstate_free */
     void *fstate;

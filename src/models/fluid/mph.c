@@ -588,6 +588,56 @@ double lub_mph_energy(const lub_mps *m, const double g[3], double dt, double par
 
 /* ---- the formulation (models/fluid.h) --------------------------------------------------- */
 
+/* The force on the particles of a body's patch (rigidBodies; methods.md §7.2): the reaction
+ * of the pair forces of (K-6) the step gave the fluid, so that fluid + body conserve
+ * momentum and, the pair forces being central, angular momentum.  With P = P^kap + lambda s
+ * after the step (K-7a; s at u^{k+1}), the step's elastic and bulk-viscous force on fluid
+ * particle a, lambda dV sum_i s_i ds_i/du_a - C P^kap, is dV sum_j (P_a + P_j) g_aj over all
+ * its neighbours j: pair terms antisymmetric in a, j (g_ja = -g_aj).  So is the viscous term
+ * -c_aj e e^T (u_a - u_j) dV (backward Euler: u^{k+1} of the fluid, the velocity the step
+ * gave the wall particle).  Wall particle b of the patch gets, over its fluid neighbours a,
+ *
+ *     f_b = dV sum_a [ (P_b + P_a) g_ba - c_ba e_ba (e_ba.(u_b - u_a)) ]  + rho dV acc_b,
+ *
+ * acc_b the reaction of the models' explicit pair forces (surface tension's F^s, stored on
+ * the wall particles by particle_forces, models/model.h).  The pairs with the patch's own
+ * and other walls' particles are left out: the former cancel over the body, the latter do
+ * not act on the fluid (a body that comes within h_p of a wall needs the contact of §7.3).
+ * The geometry is the step's (its lists at x^{k+1}), the velocities those before the body
+ * model resets the wall's to V + omega x r.  Wall and dummy particles alike (a dummy within
+ * h_v of the fluid exchanges viscous pairs).  area and omega are not used. */
+static void mph_wall_forces(const lub_mps *m, int patch, double *const area[3],
+                            const double omega[3], double *const f[3])
+{
+    (void)area, (void)omega;
+    const lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    const mph_state *S = m->fstate;
+    const int dim = m->dim;
+    const double dV = dim == 2 ? m->l0 * m->l0 : m->l0 * m->l0 * m->l0;
+    const double visc = -2.0 * m->c.rho * m->c.nu * (dim + 2), mass = m->c.rho * dV;
+    for (size_t b = 0; b < P->n; b++) {
+        for (int d = 0; d < 3; d++) f[d][b] = 0.0;
+        if (P->kind[b] == LUB_FLUID || P->patch[b] != patch || !S) continue;
+        double F[3] = {0, 0, 0};
+        for (size_t q = nb->start[b]; q < nb->end[b]; q++) {
+            const size_t a = nb->j[q];
+            if (P->kind[a] != LUB_FLUID) continue;
+            double e[3];
+            const double r = pair_r(nb, q, dim, e);
+            if (!(r < S->hv) || r == 0) continue;
+            const double cv = visc * lub_mph_dw(dim, m->l0, S->hv, r) / r;
+            double ue = 0;
+            for (int d = 0; d < dim; d++) ue += (P->u[d][b] - P->u[d][a]) * e[d];
+            const double fp =
+                r < S->hp ? (P->p[b] + P->p[a]) * lub_mph_dw(dim, m->l0, S->hp, r) : 0.0;
+            for (int d = 0; d < dim; d++) F[d] += (fp - cv * ue) * e[d];
+        }
+        for (int d = 0; d < dim; d++)
+            f[d][b] = F[d] * dV + (m->pacc[d] ? mass * m->pacc[d][b] : 0.0);
+    }
+}
+
 static void mph_read(lub_mps_config *c, const lub_case *cs, lub_node *models, lub_node *entry)
 {
     char path[LUB_PATH_MAX];
@@ -714,4 +764,5 @@ const lub_fluid_type lub_fluid_mph = {
     .header = mph_header,
     .check = mph_check,
     .log = mph_log,
+    .wall_forces = mph_wall_forces,
 };

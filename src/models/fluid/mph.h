@@ -18,7 +18,8 @@
  * Walls (the seed is silent, as Kondo's code): wall and dummy particles alike count in n_i,
  * carry their prescribed velocity, get P from (K-7a) and exchange the same pair forces; the
  * wall must be at least h_v thick (a wall layer and 3 dummy layers: particleGenDict
- * dummyLayers >= 3, checked at start-up).
+ * dummyLayers >= 3, checked at start-up).  A rigid body's force (models/fluid.h wall_forces)
+ * is the reaction of the pair forces its particles exchanged with the fluid in the step.
  *
  * The kernels, the operators and the energy are exposed for the tests
  * (tests/unit/mph_test.c).

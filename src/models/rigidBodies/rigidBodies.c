@@ -27,7 +27,9 @@
  * step the particles are put exactly on x_target (no drift of round-off), their velocity
  * set to V + omega x (x - x_G), and the force and torque the fluid exerted in the step are
  * taken from the formulation (models/fluid.h wall_forces: with mps, the wall pressure over
- * the body's surface and the reaction of the viscous terms; see fluid/mps.c):
+ * the body's surface and the reaction of the viscous terms, fluid/mps.c; with mph, the
+ * reaction of the pair forces of (K-6) and of surface tension, fluid/mph.c, which makes
+ * fluid + body conserve momentum and angular momentum to round-off):
  *
  *     F = sum_{i in patch} f_i,   T = sum_{i in patch} (x_i - x_G) x f_i.
  *

@@ -310,8 +310,16 @@ static int st_particle_forces(lub_model *m, const lub_mps *f, double *const acc[
                 vr += v[d] * nb->dx[d][q];
             }
             const double wg = lub_mph_w(dim, l0, hs, r), dwg = lub_mph_dw(dim, l0, hs, r);
-            for (int d = 0; d < dim; d++)
-                F[d] += cpp * e[d] - ak2 * c * (wg * v[d] + vr * e[d] * dwg);
+            const int wall = P->kind[j] != LUB_FLUID;
+            for (int d = 0; d < dim; d++) {
+                const double fd = cpp * e[d] - ak2 * c * (wg * v[d] + vr * e[d] * dwg);
+                F[d] += fd;
+                /* the pair term is antisymmetric (e and chi_j - chi_a change sign, M_aj is
+                 * symmetric): the wall particle gets its reaction, in the same units (per
+                 * fluid particle mass), for the force on a moving body (fluid/mph.c
+                 * wall_forces); the step adds the accelerations to fluid particles only */
+                if (wall) acc[d][j] -= fd * dA * inv_m;
+            }
         }
         for (int d = 0; d < dim; d++) acc[d][a] += F[d] * dA * inv_m;
     }
