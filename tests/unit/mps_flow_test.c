@@ -462,12 +462,7 @@ static void surface_flags_after(lub_particles *P, const lub_geometry *g, lub_mps
 {
     double *prev = lub_particles_extra(P, "surface");
     for (size_t i = 0; i < P->n; i++) prev[i] = 0;
-    c->rho = 1000;
-    c->nu = 1e-6;
-    c->viscosity = LUB_VISCOSITY_CN;
-    c->alpha = 1e-6 / (1e-3 * 1e-3);
-    lub_mps_init(m, P, c, g->dmin, g->dmax, g->periodic);
-    CHECK(run(m, 1e-9, 1) == 0);
+    surface_flags(P, g, c, m);
 }
 
 static void test_surface_film(void)
