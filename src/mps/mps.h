@@ -139,6 +139,10 @@ typedef struct {
                                        surface particles (step.c, isolated_groups) */
     unsigned long long isolated_id; /* the id of the first of them */
     double umax;                    /* largest fluid speed after the step */
+    /* The compression that holds the pressure (methods.md §2.5, (2.5b)): the mean and the
+     * largest (n* - n0)/n0 of the interior fluid particles (fluid, not on a free surface, PND at
+     * least beta n0: a full neighbourhood) at the step's r*; 0 when there are none. */
+    double compression, compression_max;
 } lub_mps_stats;
 
 /* Phases timed in every run (cost.dat columns). */

@@ -584,6 +584,30 @@ static int open_side(const lub_mps *m, size_t i, const double c[3], double ccos)
     return 0;
 }
 
+/* The compression that holds the pressure (methods.md §2.5, (2.5b)): with the PND source
+ * a steady pressure needs a lasting PND excess of about dt^2 lap(p) / (gamma rho), volume
+ * that a squeeze film's walls must first squeeze out (its pressure lags by tau = 12 mu dt^2 /
+ * (gamma rho h^2)).  The mean and the largest (n* - n0)/n0 over the interior fluid particles
+ * (not surface, PND >= beta n0) go to the log line, so that a run shows it. */
+static void compression(lub_mps *m)
+{
+    const lub_particles *P = m->P;
+    const size_t n = P->n;
+    const double lim = m->c.beta * m->n0;
+    double sum = 0, big = 0;
+    size_t k = 0;
+#pragma omp parallel for schedule(static) reduction(+ : sum, k) reduction(max : big)
+    for (size_t i = 0; i < n; i++) {
+        if (P->kind[i] != LUB_FLUID || m->surface[i] || m->pnd[i] < lim) continue;
+        double e = (m->pnd[i] - m->n0) / m->n0;
+        sum += e;
+        k++;
+        if (e > big) big = e;
+    }
+    m->st.compression = k ? sum / (double)k : 0.0;
+    m->st.compression_max = k ? big : 0.0;
+}
+
 /* Free surface (T-12): n* < beta n0, refined by a geometric test (freeSurface.test):
  *
  *   sector (default): the particle also has an open side, an empty sector (2-D) or cone
@@ -1046,6 +1070,7 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     lub_mps_mask pm = {P->kind, K_FLUID | K_WALL, K_FLUID | K_WALL | K_DUMMY};
     lub_mps_pnd(&m->nb, &pm, m->pnd);
     free_surface(m);
+    compression(m);
     lub_timer_stop(&m->tm, LUB_T_ASSEMBLY);
 
     /* 6. pressure */

@@ -23,6 +23,7 @@
 #include "geometry/geometry.h"
 #include "models/collision/collision.h"
 #include "mps/mps.h"
+#include "particles/weight.h"
 #include "test.h"
 
 static int run(lub_mps *m, double dt, long nsteps)
@@ -659,6 +660,62 @@ static void test_surface_film(void)
     lub_geometry_free(&g);
 }
 
+/* The compression the log reports (st.compression, methods.md §2.5 (2.5b)): a block of fluid
+ * at rest without gravity, its lattice scaled by s about its centre.  The first step's r* is
+ * r (u* = 0), so the largest (n* - n0)/n0 of the interior particles is that of a particle
+ * with the whole scaled lattice around it: sum_k w(s |k| l0) / sum_k w(|k| l0) - 1 over the
+ * lattice vectors k, summed here.  At s = 1 it is 0 (n0 is that lattice's PND), and the mean
+ * over the interior (which includes rows whose neighbourhood the block's edge cuts) is no
+ * larger than the largest, nor below beta - 1. */
+static void compression_of(double s)
+{
+    const char *block = "dimension: 2\n"
+                        "l0: 0.001\n"
+                        "domain: { min: [-0.05, -0.05], max: [0.05, 0.05] }\n"
+                        "fluid:\n"
+                        "  - { type: box, min: [-0.015, -0.015], max: [0.015, 0.015] }\n";
+    lub_particles P = {0};
+    lub_geometry g;
+    generate(block, &P, &g);
+    for (size_t i = 0; i < P.n; i++)
+        for (int d = 0; d < 2; d++) P.x[d][i] *= s;
+    lub_mps_config c;
+    lub_mps_config_defaults(&c);
+    c.rho = 1000;
+    c.nu = 1e-6;
+    c.viscosity = LUB_VISCOSITY_CN;
+    lub_mps m;
+    lub_mps_init(&m, &P, &c, g.dmin, g.dmax, g.periodic);
+    CHECK(run(&m, 1e-4, 1) == 0);
+    const double l0 = 0.001, re = m.re;
+    double full = 0, scaled = 0;
+    const int K = (int)ceil(re / l0 / (s < 1 ? s : 1)) + 1;
+    for (int a = -K; a <= K; a++)
+        for (int b = -K; b <= K; b++) {
+            if (!a && !b) continue;
+            const double r = l0 * sqrt((double)(a * a + b * b));
+            full += lub_mps_weight(r, re); /* (T-6) */
+            scaled += lub_mps_weight(s * r, re);
+        }
+    const double expect = scaled / full - 1;
+    printf("  lattice scaled by %.3f: largest (n* - n0)/n0 %.6f (expected %.6f), mean %.6f; "
+           "n0 %.6f (lattice sum %.6f)\n",
+           s, m.st.compression_max, expect, m.st.compression, m.n0, full);
+    CHECK(fabs(m.n0 - full) < 1e-9 * full);
+    CHECK(fabs(m.st.compression_max - expect) < 1e-9);
+    CHECK(m.st.compression <= m.st.compression_max + 1e-12);
+    CHECK(m.st.compression >= m.c.beta - 1 - 1e-12); /* interior: PND >= beta n0 */
+    lub_mps_free(&m);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+}
+
+static void test_compression(void)
+{
+    compression_of(1.0);
+    compression_of(0.98);
+}
+
 int main(void)
 {
     RUN(test_couette);
@@ -672,5 +729,6 @@ int main(void)
     RUN(test_poiseuille_jittered);
     RUN(test_hydrostatic_lsmps);
     RUN(test_surface_film);
+    RUN(test_compression);
     return test_summary();
 }

@@ -62,8 +62,10 @@ static void mps_log(const lub_mps *m, double dt, double pit, char *buf, size_t s
     (void)dt;
     int vit = 0; /* the viscosity iterations: the sum over the velocity components */
     for (int d = 0; d < m->dim; d++) vit += m->st.v[d].iterations;
-    snprintf(buf, size, "p %3d it %8.2e (mean %.1f)  U %3d it  surf %-6zu ", m->st.p.iterations,
-             m->st.p.residual, pit, vit, m->st.nsurface);
+    snprintf(buf, size,
+             "p %3d it %8.2e (mean %.1f)  U %3d it  surf %-6zu PND %+.2f%% (max %+.2f%%) ",
+             m->st.p.iterations, m->st.p.residual, pit, vit, m->st.nsurface,
+             100 * m->st.compression, 100 * m->st.compression_max);
 }
 
 /* The force on the particles of a body's patch (rigidBodies; methods.md §7).
