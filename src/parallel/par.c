@@ -10,6 +10,35 @@
 
 #include "core/error.h"
 #include "core/timer.h"
+#include "io/dict.h"
+
+static const char *const methods[] = {"slabs", NULL};
+static const char *const axes[] = {"auto", "x", "y", "z", NULL};
+
+int lub_par_read_dict(const char *path, int dim, int nranks)
+{
+    lub_dict *dd = lub_dict_read_optional(path);
+    if (!dd)
+        lub_fatal("-parallel: no '%s': it gives numberOfSubdomains and the method "
+                  "(etc/templates/decomposeParDict.yaml)",
+                  path);
+    lub_node *root = lub_dict_root(dd);
+    lub_node *nsub = lub_dict_get(root, "numberOfSubdomains");
+    const long ns = lub_node_int(nsub, 1, 1L << 20);
+    if (nranks > 0 && ns != nranks)
+        lub_node_error(nsub,
+                       "numberOfSubdomains %ld, but %s %d process%s (mpirun -np %d): run "
+                       "mpirun -np %ld lubFoam -parallel, or set numberOfSubdomains: %d",
+                       ns, lub_par_under_mpirun() ? "mpirun started" : "not under mpirun:", nranks,
+                       nranks == 1 ? "" : "es", nranks, ns, nranks);
+    lub_dict_choice(root, "method", methods, 0);
+    lub_node *sl = lub_dict_map_or(root, "slabs");
+    const int ax = lub_dict_choice(sl, "axis", axes, 0);
+    if (ax > dim) lub_node_error(lub_dict_find(sl, "axis"), "slabs axis z in a %d-D case", dim);
+    lub_dict_finish(dd);
+    lub_dict_free(dd);
+    return ax - 1;
+}
 
 int lub_par_under_mpirun(void)
 {
@@ -136,11 +165,12 @@ static void fatal_hook(int status, const char *msg)
         const struct timespec ts = {0, 100000000};
         for (int k = 0; k < 100; k++) nanosleep(&ts, NULL);
     }
-    if (startup && rank_ == 0)
+    if ((startup && rank_ == 0) || size_ == 1)
         fprintf(stderr, "%s: error: %s\n", lub_program(), msg);
     else
         fprintf(stderr, "%s: error: rank %d: %s\n", lub_program(), rank_, msg);
     fflush(stderr);
+    if (size_ == 1) exit(status); /* no other rank to end (MPI is finalised at exit) */
     MPI_Abort(MPI_COMM_WORLD, status);
     exit(status);
 }

@@ -43,6 +43,17 @@
 
 #include "particles/particles.h"
 
+/* system/decomposeParDict.yaml (etc/templates/decomposeParDict.yaml):
+ *
+ *     numberOfSubdomains: 2          # = mpirun -np
+ *     method: slabs                  # the only one yet
+ *     slabs: { axis: auto }          # auto (the fluid's longest) | x | y | z
+ *
+ * Read from path for a dim-D case; nranks > 0: numberOfSubdomains must equal it (an error
+ * at its line naming both otherwise).  Returns the axis (0, 1, 2) or -1 for auto.  Fatal
+ * (exit 1) at file:line on bad input. */
+int lub_par_read_dict(const char *path, int dim, int nranks);
+
 /* 1 when this build has MPI. */
 int lub_par_available(void);
 /* 1 when the process looks started by mpirun (Open MPI's or MPICH's environment). */

@@ -7,12 +7,8 @@
 #include <string.h>
 
 #include "core/error.h"
-#include "io/dict.h"
 #include "models/fluid.h"
 #include "lubFoam.h"
-
-static const char *const methods[] = {"slabs", NULL};
-static const char *const axes[] = {"auto", "x", "y", "z", NULL};
 
 int lubfoam_wants_parallel(int argc, char **argv)
 {
@@ -65,32 +61,13 @@ static void refuse_unparallel(const lubfoam_run *r, int nfunctions)
 void lubfoam_parallel_setup(lubfoam_run *r, const lub_geometry *geo, int nfunctions)
 {
     char path[LUB_PATH_MAX];
-    lub_case_path(&r->cs, path, "system/decomposeParDict.yaml");
-    lub_dict *dd = lub_dict_read_optional(path);
-    if (!dd)
-        lub_fatal("-parallel: no '%s': it gives numberOfSubdomains and the method "
-                  "(etc/templates/decomposeParDict.yaml)",
-                  path);
-    lub_node *root = lub_dict_root(dd);
     const int size = lub_par_size();
-    lub_node *nsub = lub_dict_get(root, "numberOfSubdomains");
-    const long ns = lub_node_int(nsub, 1, 1L << 20);
-    if (ns != size)
-        lub_node_error(nsub,
-                       "numberOfSubdomains %ld, but mpirun started %d process%s (mpirun -np "
-                       "%d): give mpirun -np %ld, or set numberOfSubdomains: %d",
-                       ns, size, size == 1 ? "" : "es", size, ns, size);
-    lub_dict_choice(root, "method", methods, 0);
-    lub_node *sl = lub_dict_map_or(root, "slabs");
-    const int ax = lub_dict_choice(sl, "axis", axes, 0);
-    if (ax > r->P.dim)
-        lub_node_error(lub_dict_find(sl, "axis"), "slabs axis z in a %d-D case", r->P.dim);
-    lub_dict_finish(dd);
-    lub_dict_free(dd);
+    const int ax = lub_par_read_dict(lub_case_path(&r->cs, path, "system/decomposeParDict.yaml"),
+                                     r->P.dim, size);
     refuse_unparallel(r, nfunctions);
 
     lub_mps *m = r->scene.level[0];
-    const int axis = ax == 0 ? lub_par_longest_axis(&r->P) : ax - 1;
+    const int axis = ax < 0 ? lub_par_longest_axis(&r->P) : ax;
     /* the halo: every particle within the lists' radius re (1 + skin) of the slab, and l0
      * for the moves within the step (the Courant limit keeps them below l0) */
     lub_par_init(&r->par, axis, m->nb.rs + m->l0, geo->dmin[axis], geo->dmax[axis],
@@ -100,7 +77,7 @@ void lubfoam_parallel_setup(lubfoam_run *r, const lub_geometry *geo, int nfuncti
     r->parallel = 1;
     lub_message("Parallel: %d ranks, slabs along %c (%s), %zu particles, at most %zu per rank "
                 "(mean %.0f), halo width %g m",
-                size, "xyz"[axis], ax == 0 ? "auto: the fluid's longest" : "given", total, most,
+                size, "xyz"[axis], ax < 0 ? "auto: the fluid's longest" : "given", total, most,
                 (double)total / size, r->par.width);
 }
 
