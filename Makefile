@@ -144,11 +144,12 @@ $(BUILD)/bench/%_bench: $(BUILD)/obj/tests/bench/%_bench.o $(LIB)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
 # deps: install missing Debian packages only when pkg-config or the CHOLMOD header is missing
-# (PETSc too, unless PETSC=0 was asked for).
+# (PETSc too, unless PETSC=0 was asked for, and mpirun with MPI).
 PETSC_DEP := $(if $(and $(filter command environment,$(PETSC_ORIGIN)),$(filter 0,$(PETSC))),,PETSc ompi-c)
 deps:
 	@pkg-config --exists $(PKGS) $(PETSC_DEP) 2>/dev/null && [ -n "$(CHOLMOD_INC)" ] \
-	  && command -v gnuplot >/dev/null || bin/installDeps
+	  && command -v gnuplot >/dev/null && { [ "$(MPI)" != 1 ] || command -v mpirun >/dev/null; } \
+	  || bin/installDeps
 
 # The recursive make re-reads pkg-config after deps may have installed packages.
 test: deps

@@ -358,6 +358,14 @@ int main(int argc, char **argv)
             "  startFrom: startTime over the results of an earlier run overwrites each time\n"
             "  folder and table the run writes again and leaves the others (the log warns,\n"
             "  listing them): lubClean removes them first, startFrom: latestTime continues.\n"
+            "  -parallel runs on the processes of 'mpirun -np N lubFoam -parallel' (a build\n"
+            "  with MPI: make MPI=1, the default with PETSc): system/decomposeParDict.yaml\n"
+            "  gives numberOfSubdomains (= N) and the slabs' axis; every rank reads the\n"
+            "  dictionaries and particles, keeps its slab and a halo of its neighbours'\n"
+            "  particles, the pressure (and implicit viscosity) is solved by PETSc over all\n"
+            "  ranks (solver: petsc in system/solution.yaml), rank 0 writes the time folders\n"
+            "  a serial run writes and the log.  Models other than gravity and movingWalls,\n"
+            "  fluid type mph, LSMPS Laplacians and function objects are refused (exit 1).\n"
             "  -dryRun reads and checks every dictionary and the start particles, prints the\n"
             "  start-up figures (particles, schemes, models, Courant and diffusion numbers,\n"
             "  multi-resolution checks), runs nothing and writes nothing.\n"
@@ -369,7 +377,7 @@ int main(int argc, char **argv)
                         "system/schemes.yaml\nsystem/solution.yaml (optional)\n"
                         "constant/transportProperties.yaml\nconstant/models.yaml\n"
                         "system/reynoldsRefDict.yaml (optional: the start-up check of "
-                        "resolution levels)",
+                        "resolution levels)\nsystem/decomposeParDict.yaml (-parallel)",
         .has_case = 1,
         .min_args = 0,
         .max_args = 0,
@@ -384,6 +392,7 @@ int main(int argc, char **argv)
                           LUB_OPT_FLAG, &parallel},
                          {0}};
     /* MPI first, before anything reads the arguments (mpirun may add its own) */
+    lub_set_program(info.name);
     if (lubfoam_wants_parallel(argc, argv)) lub_par_start(&argc, &argv);
     lub_args a;
     lub_args_parse(&a, argc, argv, &info, opts);
@@ -463,7 +472,9 @@ int main(int argc, char **argv)
         return LUB_EXIT_OK;
     }
 
-    const int tty = isatty(STDOUT_FILENO) && lubfoam_writer_rank(&r);
+    /* no progress bar in a parallel run: Open MPI gives the ranks a terminal of its own
+     * whatever mpirun's output is (a log file) */
+    const int tty = isatty(STDOUT_FILENO) && !r.parallel;
     const double wall0 = lub_wtime();
     long steps = 0, last_write_step = -1;
     double pit_sum = 0, vit_sum = 0, last_bar = 0;
