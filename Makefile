@@ -137,7 +137,12 @@ $(BUILD)/tests/liballoccount.so: tests/tools/alloccount.c $(FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	$(CC) -std=c11 -O2 -g -Wall -Wextra -fPIC -shared -o $@ $<
 
-tests: all $(TEST_BINS) $(ALLOC_COUNT)
+# A test tool linked with liblub (tests/cases/parallel builds a state particleGen does not make).
+$(BUILD)/tests/particleMove: $(BUILD)/obj/tests/tools/particleMove.o $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
+tests: all $(TEST_BINS) $(ALLOC_COUNT) $(BUILD)/tests/particleMove
 
 $(BUILD)/bench/%_bench: $(BUILD)/obj/tests/bench/%_bench.o $(LIB)
 	@mkdir -p $(dir $@)

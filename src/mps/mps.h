@@ -244,8 +244,9 @@ struct lub_mps {
     /* A run on several ranks (parallel/par.h; NULL: serial): the particles this rank owns
      * are P's first par->nown; during a step the halo follows them (lub_mps_set_parallel) */
     lub_par *par;
-    double *gidx; /* [cap] the global row of a particle's unknown (-1: none), for the halo */
-    int *colmap;  /* [cap] the global row of each local column of A */
+    double *gidx;  /* [cap] the global row of a particle's unknown (-1: none), for the halo */
+    int *colmap;   /* [cap] the global row of each local column of A */
+    uint8_t *conn; /* [cap] the isolated-group search: connected to a Dirichlet particle */
 
     lub_mps_stats st;
     double iterations[2]; /* pressure and viscosity iterations of every step so far */

@@ -137,6 +137,7 @@ void lub_mps_free(lub_mps *m)
     free(m->inside);
     free(m->gidx);
     free(m->colmap);
+    free(m->conn);
     lub_neighbours_free(&m->nb);
     lub_csr_free(&m->A);
     lub_csr_free(&m->A2);
@@ -208,13 +209,15 @@ void lub_mps_set_parallel(lub_mps *m, lub_par *d)
     if (!m->gidx) {
         m->gidx = alloc_doubles(m->cap);
         m->colmap = lub_calloc(m->cap ? m->cap : 1, sizeof *m->colmap);
+        m->conn = lub_calloc(m->cap ? m->cap : 1, 1);
     }
 }
 
 /* The unknowns' rows, after the caller set m->row[i] >= 0 for every particle that is an
  * unknown (-1 the others): the owned particles' rows numbered 0 .. nrows-1 (prow: their
  * particles), which is returned.  On several ranks (m->par) the halo's unknowns follow as
- * the columns nrows .. *ncols-1, whose global rows (m->colmap) come from their owners (so
+ * the columns nrows .. *ncols-1 (prow: their particles too), whose global rows (m->colmap)
+ * come from their owners (so
  * that a rank takes its neighbour's decision on which particle is an unknown); *nglobal:
  * the rows of all ranks.  Serial: *ncols = *nglobal = nrows. */
 static int number_rows(lub_mps *m, int *ncols, int *nglobal)
@@ -236,6 +239,7 @@ static int number_rows(lub_mps *m, int *ncols, int *nglobal)
     for (size_t i = nown; i < nown + d->nhalo; i++) {
         if (m->gidx[i] >= 0) {
             m->colmap[nc] = (int)m->gidx[i];
+            m->prow[nc] = (int)i; /* the halo particle of a column (isolated_groups_ranks) */
             m->row[i] = nc++;
         } else {
             m->row[i] = -1;
@@ -763,12 +767,6 @@ static size_t isolated_groups(lub_mps *m, int nu)
             }
             for (int k = A->row_ptr[s]; k < A->row_ptr[s + 1]; k++) {
                 const int c = A->col[k];
-                /* another rank's unknown (a run on several ranks): taken as connected, so a
-                 * group across a slab boundary is not found (doc/parallel.md) */
-                if (c >= nu) {
-                    connected = 1;
-                    break;
-                }
                 if (state[c] == -1) {
                     connected = 1;
                     break;
@@ -784,6 +782,58 @@ static size_t isolated_groups(lub_mps *m, int nu)
             m->surface[i] = 1;
             count++;
         }
+    }
+    return count;
+}
+
+/* isolated_groups on several ranks (m->par), exactly: "connected to a Dirichlet particle"
+ * spreads from the anchored rows over the matrix's graph, within the rank's rows and across
+ * the slab boundaries through the halo's copy of the flag (m->conn, refreshed from its
+ * owners), until no rank's halo copy changes: a few rounds, one per slab boundary a path of
+ * connection crosses (the flag only ever turns on, so the rounds end).  The rows left
+ * unconnected are the groups: marked as surface particles, their number returned (this
+ * rank's; the caller sums them).  Unlike the serial search, which explores at most
+ * ISOLATED_MAX rows from a few candidates, every group is found, whatever its size and
+ * however many ranks it spans; a rank cannot tell a large unconnected group from a
+ * connected one without the other ranks' rows. */
+static size_t isolated_groups_ranks(lub_mps *m, int nu, int ncols)
+{
+    const lub_par *d = m->par;
+    const lub_csr *A = &m->A;
+    const size_t nown = d->nown, n = nown + d->nhalo;
+    uint8_t *conn = m->conn;
+    int *queue = m->scratch;
+    memset(conn, 0, n);
+    for (int r = 0; r < nu; r++)
+        if (m->anchor[r]) conn[m->prow[r]] = 1;
+    for (;;) {
+        int head = 0, tail = 0;
+        for (int r = 0; r < nu; r++) { /* the seeds: anchored, or next to a connected halo */
+            const size_t i = (size_t)m->prow[r];
+            for (int k = A->row_ptr[r]; k < A->row_ptr[r + 1] && !conn[i]; k++)
+                if (A->col[k] >= nu && conn[m->prow[A->col[k]]]) conn[i] = 1;
+            if (conn[i]) queue[tail++] = r;
+        }
+        while (head < tail) {
+            const int s = queue[head++];
+            for (int k = A->row_ptr[s]; k < A->row_ptr[s + 1]; k++) {
+                const int c = A->col[k];
+                if (c < nu && !conn[m->prow[c]]) conn[m->prow[c]] = 1, queue[tail++] = c;
+            }
+        }
+        long before = 0, after = 0;
+        for (int c = nu; c < ncols; c++) before += conn[m->prow[c]];
+        lub_par_refresh(m->par, conn, 1);
+        for (int c = nu; c < ncols; c++) after += conn[m->prow[c]];
+        if (lub_par_sum_long(after != before) == 0) break;
+    }
+    size_t count = 0;
+    for (int r = 0; r < nu; r++) {
+        const size_t i = (size_t)m->prow[r];
+        if (conn[i]) continue;
+        if (count == 0) m->st.isolated_id = (unsigned long long)m->P->id[i];
+        m->surface[i] = 1;
+        count++;
     }
     return count;
 }
@@ -903,7 +953,7 @@ assemble:
     }
     lub_csr_finish(&m->A);
     if (alpha == 0 && !retried) {
-        size_t k = isolated_groups(m, nu);
+        size_t k = m->par ? isolated_groups_ranks(m, nu, ncols) : isolated_groups(m, nu);
         /* every rank assembles again when one found a group (the rows are numbered over all) */
         if (m->par) {
             if (lub_par_first(k > 0) >= 0) {

@@ -526,7 +526,7 @@ int main(int argc, char **argv)
         double umax, co = lub_scene_courant(&r.scene, r.dt, &umax);
         for (int k = 0; k < r.scene.nlevels && !warned_isolated; k++) {
             const lub_mps *mk = r.scene.level[k];
-            if (mk->st.nisolated > 0) {
+            if (mk->st.nisolated > 0 && lubfoam_writer_rank(&r)) { /* all ranks' count */
                 lub_warning("step %ld: %zu particle(s) squeezed into groups that touch no "
                             "surface particle (first: id %llu), where the pressure equation "
                             "(alpha = 0) is singular: taken as surface particles (p = 0), "
@@ -535,7 +535,8 @@ int main(int argc, char **argv)
                 warned_isolated = 1;
             }
         }
-        if (!r.ctl.adjust_time_step && co > r.ctl.max_courant && !warned_courant) {
+        if (!r.ctl.adjust_time_step && co > r.ctl.max_courant && !warned_courant &&
+            lubfoam_writer_rank(&r)) {
             lub_warning("step %ld: Courant number %.3g exceeds maxCourant %g (u_max %g m/s)",
                         r.step, co, r.ctl.max_courant, umax);
             warned_courant = 1;

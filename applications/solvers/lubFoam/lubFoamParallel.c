@@ -75,10 +75,15 @@ void lubfoam_parallel_setup(lubfoam_run *r, const lub_geometry *geo, int nfuncti
     const size_t total = r->P.n, most = lub_par_decompose(&r->par, &r->P);
     lub_mps_set_parallel(m, &r->par);
     r->parallel = 1;
+    char cuts[256] = "";
+    size_t len = 0;
+    for (int k = 1; k < size && len + 32 < sizeof cuts; k++)
+        len += (size_t)snprintf(cuts + len, sizeof cuts - len, "%s%.9g", k > 1 ? " " : "",
+                                r->par.cut[k]);
     lub_message("Parallel: %d ranks, slabs along %c (%s), %zu particles, at most %zu per rank "
-                "(mean %.0f), halo width %g m",
+                "(mean %.0f), halo width %g m%s%s",
                 size, "xyz"[axis], ax < 0 ? "auto: the fluid's longest" : "given", total, most,
-                (double)total / size, r->par.width);
+                (double)total / size, r->par.width, size > 1 ? ", cuts at " : "", cuts);
 }
 
 void lubfoam_parallel_free(lubfoam_run *r)
