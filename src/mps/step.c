@@ -1131,7 +1131,11 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
     /* several ranks: the owned particles that left the slab to their owner, then (sorted
      * among themselves) the halo after them; the lists are new every step */
-    if (par) lub_par_migrate(par, P);
+    if (par) {
+        if (par->interval > 0 && m->steps % par->interval == 0)
+            lub_par_rebalance(par, P, par->imbalance); /* new cuts: the migration moves them */
+        lub_par_migrate(par, P);
+    }
     if (m->c.reorder_interval > 0 && m->steps % m->c.reorder_interval == 0) {
         lub_mps_reorder(m);
         rebuild = 1;

@@ -15,7 +15,7 @@
 static const char *const methods[] = {"slabs", NULL};
 static const char *const axes[] = {"auto", "x", "y", "z", NULL};
 
-int lub_par_read_dict(const char *path, int dim, int nranks)
+void lub_par_read_dict(lub_par_dict *pd, const char *path, int dim, int nranks)
 {
     lub_dict *dd = lub_dict_read_optional(path);
     if (!dd)
@@ -35,9 +35,12 @@ int lub_par_read_dict(const char *path, int dim, int nranks)
     lub_node *sl = lub_dict_map_or(root, "slabs");
     const int ax = lub_dict_choice(sl, "axis", axes, 0);
     if (ax > dim) lub_node_error(lub_dict_find(sl, "axis"), "slabs axis z in a %d-D case", dim);
+    lub_node *bl = lub_dict_map_or(root, "balance");
+    pd->axis = ax - 1;
+    pd->interval = lub_dict_int_or(bl, "interval", 0, 0, 1L << 40);
+    pd->imbalance = lub_dict_real_or(bl, "imbalance", 0.1, LUB_NONNEGATIVE);
     lub_dict_finish(dd);
     lub_dict_free(dd);
-    return ax - 1;
 }
 
 int lub_par_under_mpirun(void)
@@ -121,6 +124,11 @@ int lub_par_owner(const lub_par *d, double x)
 {
     (void)d, (void)x;
     return 0;
+}
+int lub_par_rebalance(lub_par *d, const lub_particles *P, double imbalance)
+{
+    (void)d, (void)P, (void)imbalance;
+    NO_MPI("lub_par_rebalance")
 }
 void lub_par_migrate(lub_par *d, lub_particles *P)
 {
@@ -292,6 +300,7 @@ void lub_par_free(lub_par *d)
     free(d->sidx);
     free(d->sbuf);
     free(d->rbuf);
+    free(d->coord);
     memset(d, 0, sizeof *d);
 }
 
@@ -346,14 +355,11 @@ static void move_particle(lub_particles *P, size_t k, size_t i)
     for (int e = 0; e < P->nextra; e++) P->extra[e].v[k] = P->extra[e].v[i];
 }
 
-size_t lub_par_decompose(lub_par *d, lub_particles *P)
+/* The cuts at the quantiles of the n coordinates s (sorted here): rank r from the
+ * (r n / size)-th coordinate on; equal coordinates (a lattice's column) stay together, on
+ * the rank of their first. */
+static void cut_at_quantiles(lub_par *d, double *s, size_t n)
 {
-    const size_t n = P->n;
-    const int a = d->axis;
-    /* the cuts at the quantiles: rank r from the (r n / size)-th coordinate on; equal
-     * coordinates (a lattice's column) stay together, on the rank of their first */
-    double *s = lub_malloc((n ? n : 1) * sizeof *s);
-    for (size_t i = 0; i < n; i++) s[i] = P->x[a][i];
     qsort(s, n, sizeof *s, cmp_double);
     d->cut[0] = -INFINITY;
     d->cut[d->size] = INFINITY;
@@ -362,7 +368,16 @@ size_t lub_par_decompose(lub_par *d, lub_particles *P)
         d->cut[r] = n ? s[k < n ? k : n - 1] : 0.0;
         if (d->cut[r] < d->cut[r - 1]) d->cut[r] = d->cut[r - 1];
     }
-    free(s);
+}
+
+size_t lub_par_decompose(lub_par *d, lub_particles *P)
+{
+    const size_t n = P->n;
+    const int a = d->axis;
+    free(d->coord);
+    d->coord = lub_malloc((n ? n : 1) * sizeof *d->coord);
+    for (size_t i = 0; i < n; i++) d->coord[i] = P->x[a][i];
+    cut_at_quantiles(d, d->coord, n);
     size_t k = 0, most = 0;
     size_t *count = lub_calloc((size_t)d->size, sizeof *count);
     for (size_t i = 0; i < n; i++) {
@@ -378,6 +393,29 @@ size_t lub_par_decompose(lub_par *d, lub_particles *P)
     d->nhalo = 0;
     d->ntotal = n;
     return most;
+}
+
+static long displs(const int *count, int *displ, int size);
+
+int lub_par_rebalance(lub_par *d, const lub_particles *P, double imbalance)
+{
+    const double t0 = lub_wtime();
+    const double most = lub_par_max((double)d->nown), mean = (double)d->ntotal / d->size;
+    int recut = 0;
+    if (most > (1 + imbalance) * mean) {
+        int cnt = (int)d->nown;
+        MPI_Allgather(&cnt, 1, MPI_INT, d->mrcount, 1, MPI_INT, MPI_COMM_WORLD);
+        const long total = displs(d->mrcount, d->mrdispl, d->size);
+        if ((size_t)total != d->ntotal)
+            lub_bug("re-balancing: %ld particles on the ranks, %zu at the start", total, d->ntotal);
+        MPI_Allgatherv(P->x[d->axis], cnt, MPI_DOUBLE, d->coord, d->mrcount, d->mrdispl, MPI_DOUBLE,
+                       MPI_COMM_WORLD);
+        cut_at_quantiles(d, d->coord, d->ntotal);
+        d->nbalanced++;
+        recut = 1;
+    }
+    d->seconds += lub_wtime() - t0;
+    return recut;
 }
 
 /* ---- packing ---------------------------------------------------------------------------- */

@@ -48,11 +48,17 @@
  *     numberOfSubdomains: 2          # = mpirun -np
  *     method: slabs                  # the only one yet
  *     slabs: { axis: auto }          # auto (the fluid's longest) | x | y | z
+ *     balance: { interval: 0, imbalance: 0.1 }   # re-cut every interval steps (0: never)
+ *                                    # when the fullest rank holds > (1 + imbalance) x mean
  *
  * Read from path for a dim-D case; nranks > 0: numberOfSubdomains must equal it (an error
- * at its line naming both otherwise).  Returns the axis (0, 1, 2) or -1 for auto.  Fatal
- * (exit 1) at file:line on bad input. */
-int lub_par_read_dict(const char *path, int dim, int nranks);
+ * at its line naming both otherwise).  Fatal (exit 1) at file:line on bad input. */
+typedef struct {
+    int axis;         /* 0, 1, 2; -1: auto */
+    long interval;    /* balance.interval (0: never) */
+    double imbalance; /* balance.imbalance */
+} lub_par_dict;
+void lub_par_read_dict(lub_par_dict *pd, const char *path, int dim, int nranks);
 
 /* 1 when this build has MPI. */
 int lub_par_available(void);
@@ -101,6 +107,10 @@ typedef struct {
     int *mcount, *mrcount, *mdispl, *mrdispl; /* migration counts */
     double seconds;                           /* in communication (exchanges, gathers) */
     size_t nmigrated;                         /* particles this rank sent away so far */
+    long interval;    /* re-balance every interval steps (0: never; set by the caller) */
+    double imbalance; /* when the fullest rank holds > (1 + imbalance) x the mean */
+    double *coord;    /* [ntotal] every rank's coordinates on the axis (re-balancing) */
+    long nbalanced;   /* re-cuts so far */
 } lub_par;
 
 /* Slabs of the axis (0, 1, 2) of the box [lo, hi] (periodic: the axis is periodic), halo
@@ -113,6 +123,11 @@ int lub_par_longest_axis(const lub_particles *P);
  * the axis coordinate, and P keeps this rank's particles (in their order).  Returns the
  * number of particles of the most loaded rank. */
 size_t lub_par_decompose(lub_par *d, lub_particles *P);
+/* Re-balancing (P->n = nown): when the fullest rank holds more than (1 + imbalance) times
+ * the mean count, new cuts at the quantiles of all ranks' coordinates (an all-gather of
+ * them: O(N) per re-cut, fine every few tens of steps); lub_par_migrate then moves the
+ * particles.  Returns 1 when it re-cut.  Collective. */
+int lub_par_rebalance(lub_par *d, const lub_particles *P, double imbalance);
 /* The rank owning a coordinate on the axis. */
 int lub_par_owner(const lub_par *d, double x);
 /* P->n = nown on entry: owned particles whose coordinate left the slab go to their owner

@@ -295,9 +295,9 @@ static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, 
         const double comm = lub_par_max(r->par.seconds);
         const double mig = lub_par_sum((double)r->par.nmigrated);
         lub_message("  %d ranks: communication (halo, migration, gathers) %.3f s, %.1f%% of the "
-                    "wall time (the most of any rank); %.0f particles migrated; rank 0's "
-                    "phases:",
-                    r->par.size, comm, wall > 0 ? 100 * comm / wall : 0.0, mig);
+                    "wall time (the most of any rank); %.0f particles migrated; %ld "
+                    "re-balancing cuts; rank 0's phases:",
+                    r->par.size, comm, wall > 0 ? 100 * comm / wall : 0.0, mig, r->par.nbalanced);
     }
     if (!lubfoam_writer_rank(r)) return;
     for (int k = 0; k < LUB_T_COUNT; k++)
@@ -360,12 +360,13 @@ int main(int argc, char **argv)
             "  listing them): lubClean removes them first, startFrom: latestTime continues.\n"
             "  -parallel runs on the processes of 'mpirun -np N lubFoam -parallel' (a build\n"
             "  with MPI: make MPI=1, the default with PETSc): system/decomposeParDict.yaml\n"
-            "  gives numberOfSubdomains (= N) and the slabs' axis; every rank reads the\n"
-            "  dictionaries and particles, keeps its slab and a halo of its neighbours'\n"
-            "  particles, the pressure (and implicit viscosity) is solved by PETSc over all\n"
-            "  ranks (solver: petsc in system/solution.yaml), rank 0 writes the time folders\n"
-            "  a serial run writes and the log.  Models other than gravity and movingWalls,\n"
-            "  fluid type mph, LSMPS Laplacians and function objects are refused (exit 1).\n"
+            "  gives numberOfSubdomains (= N), the slabs' axis and their re-balancing; every\n"
+            "  rank reads the dictionaries and particles, keeps its slab and a halo of its\n"
+            "  neighbours' particles, the pressure (and implicit viscosity) is solved by\n"
+            "  PETSc over all ranks (solver: petsc in system/solution.yaml), rank 0 writes\n"
+            "  the time folders a serial run writes and the log.  Models other than gravity\n"
+            "  and movingWalls, fluid type mph, LSMPS Laplacians and function objects are\n"
+            "  refused (exit 1).\n"
             "  -dryRun reads and checks every dictionary and the start particles, prints the\n"
             "  start-up figures (particles, schemes, models, Courant and diffusion numbers,\n"
             "  multi-resolution checks), runs nothing and writes nothing.\n"

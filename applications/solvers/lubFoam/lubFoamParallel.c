@@ -62,8 +62,10 @@ void lubfoam_parallel_setup(lubfoam_run *r, const lub_geometry *geo, int nfuncti
 {
     char path[LUB_PATH_MAX];
     const int size = lub_par_size();
-    const int ax = lub_par_read_dict(lub_case_path(&r->cs, path, "system/decomposeParDict.yaml"),
-                                     r->P.dim, size);
+    lub_par_dict pd;
+    lub_par_read_dict(&pd, lub_case_path(&r->cs, path, "system/decomposeParDict.yaml"), r->P.dim,
+                      size);
+    const int ax = pd.axis;
     refuse_unparallel(r, nfunctions);
 
     lub_mps *m = r->scene.level[0];
@@ -72,6 +74,8 @@ void lubfoam_parallel_setup(lubfoam_run *r, const lub_geometry *geo, int nfuncti
      * for the moves within the step (the Courant limit keeps them below l0) */
     lub_par_init(&r->par, axis, m->nb.rs + m->l0, geo->dmin[axis], geo->dmax[axis],
                  geo->periodic[axis]);
+    r->par.interval = pd.interval;
+    r->par.imbalance = pd.imbalance;
     const size_t total = r->P.n, most = lub_par_decompose(&r->par, &r->P);
     lub_mps_set_parallel(m, &r->par);
     r->parallel = 1;

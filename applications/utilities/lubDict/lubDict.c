@@ -163,7 +163,8 @@ static void read_decompose(const char *file, const char *root)
     lub_case_open(&c, root);
     lub_geometry g;
     lub_geometry_read(&g, lub_case_path(&c, path, "system/particleGenDict.yaml"));
-    lub_par_read_dict(file, g.dim, 0);
+    lub_par_dict pd;
+    lub_par_read_dict(&pd, file, g.dim, 0);
     lub_geometry_free(&g);
 }
 
