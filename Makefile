@@ -13,7 +13,8 @@
 #
 # SANITIZE=address builds into build-asan/ with AddressSanitizer (make SANITIZE=address test).
 # PETSC=0 builds without PETSc (the 'petsc' linear solver), PETSC=1 requires it; by default
-# it is built in when installed (bin/installDeps installs it).
+# it is built in when installed (bin/installDeps installs it).  MPI=0 builds without MPI
+# (lubFoam -parallel); by default MPI comes with PETSc.
 #
 # Code generation: OPT (default -O3) and ARCH (default -march=native: the processor building
 # is the one running, as on a workstation or a cluster's compute node; `make ARCH=` builds
@@ -58,6 +59,16 @@ ifeq ($(PETSC),1)
     $(error PETSC=1 but pkg-config finds no PETSc and ompi-c: install petsc-dev (bin/installDeps))
   endif
 endif
+# MPI (Open MPI, with PETSc: `mpirun -np N lubFoam -parallel`, src/parallel/par.h): built in
+# with PETSc, whose distributed solves a parallel run needs; MPI=0 leaves it out (lubFoam
+# -parallel is then an error saying so).  Only src/parallel/par.c sees MPI's header.
+MPI           ?= $(PETSC)
+ifeq ($(MPI),1)
+  ifneq ($(PETSC),1)
+    $(error MPI=1 needs PETSc (PETSC=1) for the distributed pressure solve)
+  endif
+  MPI_CFLAGS  := -DLUB_HAVE_MPI $(shell pkg-config --cflags ompi-c)
+endif
 CHOLMOD_INC   ?= $(firstword $(wildcard /usr/include/suitesparse /usr/local/include/suitesparse))
 CHOLMOD_LIBS  ?= -lcholmod -lsuitesparseconfig
 
@@ -91,7 +102,7 @@ all: $(LIB) $(BINS)
 # The code-generation flags of the objects in $(BUILD): rewritten (and so newer than every
 # object) only when they change.
 FLAGS_STAMP := $(BUILD)/flags
-FLAGS_NOW   := $(CC) $(OPT) $(ARCH) -fno-math-errno PETSC=$(PETSC)
+FLAGS_NOW   := $(CC) $(OPT) $(ARCH) -fno-math-errno PETSC=$(PETSC) MPI=$(MPI)
 $(shell mkdir -p $(BUILD) && { [ "$$(cat $(FLAGS_STAMP) 2>/dev/null)" = '$(FLAGS_NOW)' ] \
           || echo '$(FLAGS_NOW)' > $(FLAGS_STAMP); })
 
@@ -100,6 +111,7 @@ $(BUILD)/obj/%.o: %.c $(FLAGS_STAMP)
 	$(CC) $(CPPFLAGS) $(CFLAGS) -c $< -o $@
 
 $(BUILD)/obj/src/linalg/petsc_solver.o: CPPFLAGS += $(PETSC_CFLAGS)
+$(BUILD)/obj/src/parallel/par.o: CPPFLAGS += $(MPI_CFLAGS)
 
 $(LIB): $(LIB_OBJ)
 	@mkdir -p $(dir $@)
@@ -125,18 +137,24 @@ $(BUILD)/tests/liballoccount.so: tests/tools/alloccount.c $(FLAGS_STAMP)
 	@mkdir -p $(dir $@)
 	$(CC) -std=c11 -O2 -g -Wall -Wextra -fPIC -shared -o $@ $<
 
-tests: all $(TEST_BINS) $(ALLOC_COUNT)
+# A test tool linked with liblub (tests/cases/parallel builds a state particleGen does not make).
+$(BUILD)/tests/particleMove: $(BUILD)/obj/tests/tools/particleMove.o $(LIB)
+	@mkdir -p $(dir $@)
+	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
+
+tests: all $(TEST_BINS) $(ALLOC_COUNT) $(BUILD)/tests/particleMove
 
 $(BUILD)/bench/%_bench: $(BUILD)/obj/tests/bench/%_bench.o $(LIB)
 	@mkdir -p $(dir $@)
 	$(CC) $(LDFLAGS) -o $@ $^ $(LDLIBS)
 
 # deps: install missing Debian packages only when pkg-config or the CHOLMOD header is missing
-# (PETSc too, unless PETSC=0 was asked for).
+# (PETSc too, unless PETSC=0 was asked for, and mpirun with MPI).
 PETSC_DEP := $(if $(and $(filter command environment,$(PETSC_ORIGIN)),$(filter 0,$(PETSC))),,PETSc ompi-c)
 deps:
 	@pkg-config --exists $(PKGS) $(PETSC_DEP) 2>/dev/null && [ -n "$(CHOLMOD_INC)" ] \
-	  && command -v gnuplot >/dev/null || bin/installDeps
+	  && command -v gnuplot >/dev/null && { [ "$(MPI)" != 1 ] || command -v mpirun >/dev/null; } \
+	  || bin/installDeps
 
 # The recursive make re-reads pkg-config after deps may have installed packages.
 test: deps

@@ -8,10 +8,29 @@
 static const char *program_name = "lubkit";
 static int quiet = 0;
 static lub_catcher *catcher = NULL;
+static lub_fatal_hook fatal_hook = NULL;
+static const char *warning_prefix = "";
 
-void lub_set_program(const char *name) { program_name = name; }
-const char *lub_program(void) { return program_name; }
-void lub_set_quiet(int q) { quiet = q; }
+void lub_set_program(const char *name)
+{
+    program_name = name;
+}
+const char *lub_program(void)
+{
+    return program_name;
+}
+void lub_set_quiet(int q)
+{
+    quiet = q;
+}
+void lub_set_fatal_hook(lub_fatal_hook hook)
+{
+    fatal_hook = hook;
+}
+void lub_set_warning_prefix(const char *prefix)
+{
+    warning_prefix = prefix;
+}
 
 void lub_message(const char *fmt, ...)
 {
@@ -25,9 +44,10 @@ void lub_message(const char *fmt, ...)
 
 void lub_warning(const char *fmt, ...)
 {
+    if (!warning_prefix) return;
     va_list ap;
     fflush(stdout);
-    fprintf(stderr, "%s: warning: ", program_name);
+    fprintf(stderr, "%s: %swarning: ", program_name, warning_prefix);
     va_start(ap, fmt);
     vfprintf(stderr, fmt, ap);
     va_end(ap);
@@ -70,6 +90,7 @@ _Noreturn void lub_vfatal_at(int status, const char *file, int line, int col, co
         c->status = status;
         longjmp(c->env, 1);
     }
+    if (fatal_hook) fatal_hook(status, msg); /* does not return (lub_set_fatal_hook) */
     fflush(stdout);
     fprintf(stderr, "%s: error: %s\n", program_name, msg);
     exit(status);

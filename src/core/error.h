@@ -26,6 +26,14 @@ const char *lub_program(void);
 /* Informational output on stdout; suppressed by lub_set_quiet(1). */
 void lub_message(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 void lub_set_quiet(int quiet);
+/* A program run on several MPI processes (src/parallel/par.h) ends them all on a fatal error:
+ * the hook, when set, takes the message (without the program prefix) and the exit status
+ * instead of the print-and-exit, and must not return.  NULL: the default. */
+typedef void (*lub_fatal_hook)(int status, const char *msg);
+void lub_set_fatal_hook(lub_fatal_hook hook);
+/* Put between "<program>: " and "warning: " ("rank 3: "; "" none, the default); NULL: no
+ * warnings at all (the other ranks while they repeat rank 0's start-up). */
+void lub_set_warning_prefix(const char *prefix);
 /* Warnings on stderr: "<program>: warning: ...". */
 void lub_warning(const char *fmt, ...) __attribute__((format(printf, 1, 2)));
 

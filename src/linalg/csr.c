@@ -34,9 +34,21 @@ void lub_csr_begin(lub_csr *A, int n)
         A->n_cap = cap;
     }
     A->n = n;
+    A->ncols = n;
+    A->colmap = NULL;
+    A->nglobal = 0;
     A->nnz = 0;
     A->row_ptr[0] = 0;
     A->finished = 0;
+}
+
+void lub_csr_set_distributed(lub_csr *A, int ncols, const int *colmap, int nglobal)
+{
+    if (ncols < A->n || !colmap || nglobal < A->n)
+        lub_bug("distributed matrix of %d rows: %d columns, %d global", A->n, ncols, nglobal);
+    A->ncols = ncols;
+    A->colmap = colmap;
+    A->nglobal = nglobal;
 }
 
 void lub_csr_alloc(lub_csr *A)
@@ -44,7 +56,7 @@ void lub_csr_alloc(lub_csr *A)
     long long nnz = 0;
     for (int i = 0; i < A->n; i++) {
         int len = A->row_ptr[i + 1];
-        if (len < 1 || len > A->n) lub_bug("row %d of %d has length %d", i, A->n, len);
+        if (len < 1 || len > A->ncols) lub_bug("row %d of %d has length %d", i, A->n, len);
         nnz += len;
         if (nnz > INT_MAX)
             lub_fatal_run("sparse matrix of %d rows has more than %d entries (int indices)", A->n,
@@ -100,7 +112,7 @@ void lub_csr_finish(lub_csr *A)
         }
         if (len > 0 && c[len - 1] == i) d = len - 1;
         int kind = 0;
-        if (len > 0 && (c[0] < 0 || c[len - 1] >= n))
+        if (len > 0 && (c[0] < 0 || c[len - 1] >= A->ncols))
             kind = 1;
         else if (k < len)
             kind = 2; /* sorted, but not strictly: a repeated column */

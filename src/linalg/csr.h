@@ -49,6 +49,13 @@ typedef struct lub_csr {
      * set-up to catch a solve with a stale preconditioner or factor */
     unsigned long stamp;
     int finished; /* 1 between lub_csr_finish and the next lub_csr_begin */
+    /* A distributed matrix (a run on several ranks, parallel/par.h): these n rows of nglobal,
+     * with local columns 0 .. ncols-1 whose global numbers are colmap[c] (the rows' own
+     * first, then the columns of other ranks' unknowns).  Serial: ncols = n, colmap NULL.
+     * Only the PETSc solver takes a distributed matrix (linalg/linsolve.h). */
+    int ncols;
+    const int *colmap;
+    int nglobal;
 } lub_csr;
 
 /* An empty matrix (all arrays NULL); lub_csr_free releases the arrays. */
@@ -62,6 +69,10 @@ static inline void lub_csr_set_row_length(lub_csr *A, int i, int len)
 {
     A->row_ptr[i + 1] = len;
 }
+/* After lub_csr_begin (which makes the matrix serial again): a distributed matrix of ncols
+ * local columns, colmap[c] their global numbers (kept by the caller), nglobal rows in all. */
+void lub_csr_set_distributed(lub_csr *A, int ncols, const int *colmap, int nglobal);
+
 /* End of pass 1: prefix sum of the lengths, grows col/val when nnz exceeds the capacity.
  * A fatal run error (exit 2) if nnz would overflow int. */
 void lub_csr_alloc(lub_csr *A);

@@ -67,6 +67,9 @@ lub_solve_status lub_linsolver_setup(lub_linsolver *s, const lub_csr *A, lub_sol
     lub_solve_result local;
     if (!res) res = &local;
     s->ready = 0;
+    if (A->colmap && s->o.kind != LUB_LINSOLVER_PETSC)
+        lub_bug("a distributed matrix for the serial solver %s (only petsc solves over ranks)",
+                lub_linsolver_choice_names[s->o.kind]);
     if (s->o.kind == LUB_LINSOLVER_CHOLMOD) {
         lub_cholmod_factorize(s->chol, A, s->o.pattern, res);
     } else if (s->o.kind == LUB_LINSOLVER_PETSC) {

@@ -67,6 +67,14 @@ struct lub_petsc {
     int n, nnz;     /* size of A and of the vectors (0: none yet) */
     int *ptr, *col; /* the pattern A was made with (MatUpdateMPIAIJWithArrays needs it) */
     int n_cap, nnz_cap;
+    /* a distributed matrix (A->colmap): its rows in global columns, sorted within each row
+     * (MatUpdateMPIAIJWithArrays copies the values of a row in the order of its global
+     * columns), perm[k] the entry of A's row that is the k-th of the sorted row */
+    int dist, nglobal;
+    int *gcol, *perm;
+    double *gval;
+    int g_cap;
+    Vec rv;            /* the residual (distributed) */
     double *r;         /* residual work, n_cap */
     const lub_csr *As; /* the CSR and stamp of the last set-up */
     unsigned long stamp;
@@ -123,6 +131,7 @@ static void destroy_objects(lub_petsc *s)
     if (s->A) MatDestroy(&s->A);
     if (s->b) VecDestroy(&s->b);
     if (s->x) VecDestroy(&s->x);
+    if (s->rv) VecDestroy(&s->rv);
     s->n = s->nnz = 0;
 }
 
@@ -133,6 +142,9 @@ void lub_petsc_free(lub_petsc *s)
     free(s->ptr);
     free(s->col);
     free(s->r);
+    free(s->gcol);
+    free(s->perm);
+    free(s->gval);
     free(s);
 }
 
@@ -142,11 +154,40 @@ void lub_petsc_free(lub_petsc *s)
         if ((call) != 0) goto fail;                                                                \
     } while (0)
 
-static int same_pattern(const lub_petsc *s, const lub_csr *A)
+/* cols: A's columns as PETSc takes them (global and sorted: distributed_columns) */
+static int same_pattern(const lub_petsc *s, const lub_csr *A, const int *cols)
 {
-    return s->A && s->n == A->n && s->nnz == A->nnz &&
-           !memcmp(s->ptr, A->row_ptr, (size_t)(A->n + 1) * sizeof *s->ptr) &&
-           !memcmp(s->col, A->col, (size_t)A->nnz * sizeof *s->col);
+    return s->A && s->dist == (A->colmap != NULL) && s->nglobal == A->nglobal && s->n == A->n &&
+           s->nnz == A->nnz && !memcmp(s->ptr, A->row_ptr, (size_t)(A->n + 1) * sizeof *s->ptr) &&
+           !memcmp(s->col, cols, (size_t)A->nnz * sizeof *s->col);
+}
+
+/* A distributed matrix's rows in global columns (A->colmap of its local ones), each row
+ * sorted, into s->gcol and its values into s->gval (s->perm: where each came from). */
+static void distributed_rows(lub_petsc *s, const lub_csr *A)
+{
+    if (A->nnz > s->g_cap) {
+        free(s->gcol), free(s->perm), free(s->gval);
+        s->g_cap = A->nnz + A->nnz / 8 + 16;
+        s->gcol = lub_malloc((size_t)s->g_cap * sizeof *s->gcol);
+        s->perm = lub_malloc((size_t)s->g_cap * sizeof *s->perm);
+        s->gval = lub_malloc((size_t)s->g_cap * sizeof *s->gval);
+    }
+    for (int i = 0; i < A->n; i++) {
+        const int a = A->row_ptr[i], b = A->row_ptr[i + 1];
+        for (int k = a; k < b; k++) { /* insertion sort: a few tens of entries */
+            const int g = A->colmap[A->col[k]];
+            int l = k - 1;
+            while (l >= a && s->gcol[l] > g) {
+                s->gcol[l + 1] = s->gcol[l];
+                s->perm[l + 1] = s->perm[l];
+                l--;
+            }
+            s->gcol[l + 1] = g;
+            s->perm[l + 1] = k;
+        }
+    }
+    for (int k = 0; k < A->nnz; k++) s->gval[k] = A->val[s->perm[k]];
 }
 
 /* The KSP with its method, preconditioner and norm, made once per matrix object. */
@@ -177,9 +218,23 @@ lub_solve_status lub_petsc_setup(lub_petsc *s, const lub_csr *A, const lub_pcg_o
     res->column = -1;
     res->status = LUB_SOLVE_FAILED;
     s->ready = 0;
-    if (same_pattern(s, A)) {
+    /* serial: our CSR as it is; distributed: its rows in global columns, sorted */
+    const int dist = A->colmap != NULL;
+    const int *cols = A->col;
+    const double *vals = A->val;
+    const int N = dist ? A->nglobal : A->n;
+    if (dist) {
+        distributed_rows(s, A);
+        cols = s->gcol;
+        vals = s->gval;
+    }
+    int same = same_pattern(s, A, cols);
+    /* a new matrix is made by every rank or none (MatCreateMPIAIJWithArrays is collective) */
+    if (dist && MPI_Allreduce(MPI_IN_PLACE, &same, 1, MPI_INT, MPI_LAND, PETSC_COMM_WORLD))
+        goto fail;
+    if (same) {
         /* the values only, into the matrix PETSc already holds */
-        TRY(MatUpdateMPIAIJWithArrays(s->A, A->n, A->n, A->n, A->n, A->row_ptr, A->col, A->val));
+        TRY(MatUpdateMPIAIJWithArrays(s->A, A->n, A->n, N, N, A->row_ptr, cols, vals));
     } else {
         destroy_objects(s);
         if (A->n > s->n_cap) {
@@ -195,14 +250,18 @@ lub_solve_status lub_petsc_setup(lub_petsc *s, const lub_csr *A, const lub_pcg_o
             s->nnz_cap = A->nnz;
         }
         memcpy(s->ptr, A->row_ptr, (size_t)(A->n + 1) * sizeof *s->ptr);
-        memcpy(s->col, A->col, (size_t)A->nnz * sizeof *s->col);
-        /* this process's rows (all of them on one), global columns */
-        TRY(MatCreateMPIAIJWithArrays(s->comm, A->n, A->n, A->n, A->n, A->row_ptr, A->col, A->val,
-                                      &s->A));
+        memcpy(s->col, cols, (size_t)A->nnz * sizeof *s->col);
+        s->dist = dist;
+        s->nglobal = A->nglobal;
+        /* this process's rows (all of them on one), global columns; a distributed matrix
+         * on every rank (PETSc was started on MPI_COMM_WORLD: parallel/par.h) */
+        s->comm = dist ? PETSC_COMM_WORLD : PETSC_COMM_SELF;
+        TRY(MatCreateMPIAIJWithArrays(s->comm, A->n, A->n, N, N, A->row_ptr, cols, vals, &s->A));
         TRY(MatSetOption(s->A, MAT_SYMMETRIC, PETSC_TRUE));
         TRY(MatSetOption(s->A, MAT_SPD, PETSC_TRUE));
-        TRY(VecCreateMPIWithArray(s->comm, 1, A->n, A->n, NULL, &s->b));
-        TRY(VecCreateMPIWithArray(s->comm, 1, A->n, A->n, NULL, &s->x));
+        TRY(VecCreateMPIWithArray(s->comm, 1, A->n, N, NULL, &s->b));
+        TRY(VecCreateMPIWithArray(s->comm, 1, A->n, N, NULL, &s->x));
+        if (dist) TRY(MatCreateVecs(s->A, NULL, &s->rv));
         s->n = A->n;
         s->nnz = A->nnz;
         if (make_ksp(s)) goto fail;
@@ -238,6 +297,15 @@ static lub_solve_status reason_status(KSPConvergedReason why)
     }
 }
 
+/* ||b - A x|| / ||b|| of a distributed matrix (x, b placed in s->x, s->b), over all ranks */
+static double distributed_residual(lub_petsc *s, double bn)
+{
+    PetscReal rn = 0.0;
+    if (MatMult(s->A, s->x, s->rv) || VecAYPX(s->rv, -1.0, s->b) || VecNorm(s->rv, NORM_2, &rn))
+        return NAN;
+    return (double)rn / bn;
+}
+
 lub_solve_status lub_petsc_solve(lub_petsc *s, const lub_csr *A, int nrhs, const double *const *b,
                                  double *const *x, const lub_pcg_options *o, lub_solve_result *res)
 {
@@ -252,8 +320,15 @@ lub_solve_status lub_petsc_solve(lub_petsc *s, const lub_csr *A, int nrhs, const
         memset(r, 0, sizeof *r);
         r->column = -1;
         double bn = 0.0;
-        for (int i = 0; i < A->n; i++) bn += b[k][i] * b[k][i];
-        bn = sqrt(bn);
+        if (s->dist) { /* over every rank's rows */
+            PetscReal v = 0.0;
+            if (VecPlaceArray(s->b, b[k]) || VecNorm(s->b, NORM_2, &v) || VecResetArray(s->b))
+                v = NAN;
+            bn = (double)v;
+        } else {
+            for (int i = 0; i < A->n; i++) bn += b[k][i] * b[k][i];
+            bn = sqrt(bn);
+        }
         if (!isfinite(bn)) {
             r->status = LUB_SOLVE_NONFINITE;
         } else if (bn == 0.0) {
@@ -262,7 +337,13 @@ lub_solve_status lub_petsc_solve(lub_petsc *s, const lub_csr *A, int nrhs, const
         } else {
             KSPConvergedReason why = KSP_CONVERGED_ITERATING;
             PetscInt its = 0;
-            if (o->warm_start) {
+            if (o->warm_start && s->dist) {
+                r->residual0 = NAN;
+                if (!VecPlaceArray(s->b, b[k]) && !VecPlaceArray(s->x, x[k]))
+                    r->residual0 = distributed_residual(s, bn);
+                VecResetArray(s->b);
+                VecResetArray(s->x);
+            } else if (o->warm_start) {
                 lub_csr_spmv(A, x[k], s->r);
                 double r0 = 0.0;
                 for (int i = 0; i < A->n; i++) r0 += (b[k][i] - s->r[i]) * (b[k][i] - s->r[i]);
@@ -273,15 +354,20 @@ lub_solve_status lub_petsc_solve(lub_petsc *s, const lub_csr *A, int nrhs, const
             /* the caller's arrays in PETSc's vectors, no copy */
             if (VecPlaceArray(s->b, b[k]) || VecPlaceArray(s->x, x[k]) ||
                 KSPSolve(s->ksp, s->b, s->x) || KSPGetConvergedReason(s->ksp, &why) ||
-                KSPGetIterationNumber(s->ksp, &its) || VecResetArray(s->b) || VecResetArray(s->x))
+                KSPGetIterationNumber(s->ksp, &its))
                 why = KSP_DIVERGED_PC_FAILED;
             r->iterations = (int)its;
             r->status = reason_status(why);
             /* the true residual, as the other solvers report it */
-            lub_csr_spmv(A, x[k], s->r);
-            double rn = 0.0;
-            for (int i = 0; i < A->n; i++) rn += (b[k][i] - s->r[i]) * (b[k][i] - s->r[i]);
-            r->residual = sqrt(rn) / bn;
+            if (s->dist) {
+                r->residual = distributed_residual(s, bn);
+            } else {
+                lub_csr_spmv(A, x[k], s->r);
+                double rn = 0.0;
+                for (int i = 0; i < A->n; i++) rn += (b[k][i] - s->r[i]) * (b[k][i] - s->r[i]);
+                r->residual = sqrt(rn) / bn;
+            }
+            if (VecResetArray(s->b) || VecResetArray(s->x)) r->status = LUB_SOLVE_FAILED;
             if (r->status == LUB_SOLVE_OK && !isfinite(r->residual))
                 r->status = LUB_SOLVE_NONFINITE;
         }

@@ -10,9 +10,10 @@
  *     lub_petsc_free(s);
  *
  * The matrix is a PETSc AIJ matrix made from the rows of our CSR (MatCreateMPIAIJWithArrays:
- * this process's rows with global column numbers, on PETSC_COMM_SELF for now, so that the
- * distributed matrix of a decomposed run is the same call with its row range and
- * communicator).  While the pattern stays (compared, as CHOLMOD's analysis is: row pointers
+ * this process's rows with global column numbers): serially on PETSC_COMM_SELF; a
+ * distributed CSR (csr.h: A->colmap, lubFoam -parallel) on PETSC_COMM_WORLD, each rank's
+ * rows in global columns (sorted within each row), the norms over all ranks, and a new
+ * matrix made by every rank when any rank's pattern changed.  While the pattern stays (compared, as CHOLMOD's analysis is: row pointers
  * and columns kept), only the values are copied in (MatUpdateMPIAIJWithArrays: no
  * allocation on our side); a new pattern makes a new matrix.  The right-hand sides and
  * solutions are the caller's arrays placed in two PETSc vectors (VecPlaceArray: no copy).

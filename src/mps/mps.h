@@ -55,6 +55,7 @@
 #include "linalg/bicgstab.h"
 #include "linalg/linsolve.h"
 #include "mps/neighbours.h"
+#include "parallel/par.h"
 #include "particles/particles.h"
 
 enum { LUB_GRADIENT_STANDARD = 0, LUB_GRADIENT_LSMPS = 1 };
@@ -244,6 +245,13 @@ struct lub_mps {
     void *fstate;
     void (*fstate_free)(void *fstate);
 
+    /* A run on several ranks (parallel/par.h; NULL: serial): the particles this rank owns
+     * are P's first par->nown; during a step the halo follows them (lub_mps_set_parallel) */
+    lub_par *par;
+    double *gidx;  /* [cap] the global row of a particle's unknown (-1: none), for the halo */
+    int *colmap;   /* [cap] the global row of each local column of A */
+    uint8_t *conn; /* [cap] the isolated-group search: connected to a Dirichlet particle */
+
     lub_mps_stats st;
     double iterations[2]; /* pressure and viscosity iterations of every step so far */
     lub_timers tm;
@@ -258,6 +266,16 @@ struct lub_mps {
 void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const double lo[3],
                   const double hi[3], const int periodic[3]);
 void lub_mps_free(lub_mps *m);
+
+/* Solve on several ranks (parallel/par.h): this rank's particles are P's first d->nown
+ * (lub_par_decompose done).  Each step then migrates, builds the halo, refreshes it after
+ * each phase whose result a neighbour reads (u* after the viscous step, the free-surface
+ * flags, the global rows of the unknowns, the pressure after the solve), solves the pressure
+ * and viscosity equations over all ranks (a distributed CSR: linalg/csr.h, PETSc only) and
+ * leaves P->n = d->nown.  The step's status, statistics and the largest speed are those of
+ * all ranks.  Refused here (lub_bug; lubFoam refuses them first): the LSMPS Laplacians,
+ * given particles (multiResolution), a formulation with its own step. */
+void lub_mps_set_parallel(lub_mps *m, lub_par *d);
 
 /* Status of a step. */
 typedef enum {

@@ -135,6 +135,9 @@ void lub_mps_free(lub_mps *m)
     free(m->scratch);
     free(m->fixed);
     free(m->inside);
+    free(m->gidx);
+    free(m->colmap);
+    free(m->conn);
     lub_neighbours_free(&m->nb);
     lub_csr_free(&m->A);
     lub_csr_free(&m->A2);
@@ -197,12 +200,64 @@ void lub_mps_relist(lub_mps *m)
     neighbours(m, 1);
 }
 
-/* Pass 1 of the CSR assembly of an MPS matrix over the unknowns prow[0..nrows): row r has
- * the diagonal and one entry per neighbour j with w_ij > 0 that is itself an unknown. */
-static void begin_rows(lub_mps *m, int nrows)
+void lub_mps_set_parallel(lub_mps *m, lub_par *d)
 {
-    const lub_neighbours *nb = &m->nb;
+    if (m->fixed || m->c.lap_pressure == LUB_LAPLACIAN_LSMPS ||
+        m->c.lap_viscosity == LUB_LAPLACIAN_LSMPS)
+        lub_bug("lub_mps_set_parallel: given particles or an LSMPS Laplacian (not parallel)");
+    m->par = d;
+    if (!m->gidx) {
+        m->gidx = alloc_doubles(m->cap);
+        m->colmap = lub_calloc(m->cap ? m->cap : 1, sizeof *m->colmap);
+        m->conn = lub_calloc(m->cap ? m->cap : 1, 1);
+    }
+}
+
+/* The unknowns' rows, after the caller set m->row[i] >= 0 for every particle that is an
+ * unknown (-1 the others): the owned particles' rows numbered 0 .. nrows-1 (prow: their
+ * particles), which is returned.  On several ranks (m->par) the halo's unknowns follow as
+ * the columns nrows .. *ncols-1 (prow: their particles too), whose global rows (m->colmap)
+ * come from their owners (so
+ * that a rank takes its neighbour's decision on which particle is an unknown); *nglobal:
+ * the rows of all ranks.  Serial: *ncols = *nglobal = nrows. */
+static int number_rows(lub_mps *m, int *ncols, int *nglobal)
+{
+    lub_par *d = m->par;
+    const size_t nown = d ? d->nown : m->P->n;
+    int nu = 0;
+    for (size_t i = 0; i < nown; i++)
+        if (m->row[i] >= 0) m->prow[nu] = (int)i, m->row[i] = nu++;
+    *ncols = nu;
+    *nglobal = nu;
+    if (!d) return nu;
+    const long off = lub_par_exscan(nu);
+    *nglobal = (int)lub_par_sum_long(nu);
+    for (size_t i = 0; i < nown; i++) m->gidx[i] = m->row[i] >= 0 ? (double)(off + m->row[i]) : -1;
+    lub_par_refresh(d, m->gidx, sizeof *m->gidx);
+    for (int r = 0; r < nu; r++) m->colmap[r] = (int)off + r;
+    int nc = nu;
+    for (size_t i = nown; i < nown + d->nhalo; i++) {
+        if (m->gidx[i] >= 0) {
+            m->colmap[nc] = (int)m->gidx[i];
+            m->prow[nc] = (int)i; /* the halo particle of a column (isolated_groups_ranks) */
+            m->row[i] = nc++;
+        } else {
+            m->row[i] = -1;
+        }
+    }
+    *ncols = nc;
+    return nu;
+}
+
+/* Pass 1 of the CSR assembly of an MPS matrix over the unknowns prow[0..nrows) of
+ * number_rows: row r has the diagonal and one entry per neighbour j with w_ij > 0 that is
+ * itself an unknown (one of this rank's rows or a halo column); on several ranks the matrix
+ * is distributed (linalg/csr.h). */
+static void begin_rows(lub_mps *m, int nrows, int ncols, int nglobal)
+{
     lub_csr_begin(&m->A, nrows);
+    if (m->par) lub_csr_set_distributed(&m->A, ncols, m->colmap, nglobal);
+    const lub_neighbours *nb = &m->nb;
 #pragma omp parallel for schedule(static)
     for (int r = 0; r < nrows; r++) {
         size_t i = (size_t)m->prow[r];
@@ -385,13 +440,11 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
         const double k = lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, 0.5 * dt * m->c.nu);
         const lub_neighbours *nb = &m->nb;
         const double gm = m->c.mirror_dummies ? 2.0 : 1.0;
-        int nf = 0;
-        for (size_t i = 0; i < n; i++) {
-            const int unknown = P->kind[i] == LUB_FLUID && !(fix && fix[i]);
-            m->row[i] = unknown ? nf : -1;
-            if (unknown) m->prow[nf++] = (int)i;
-        }
-        begin_rows(m, nf);
+        for (size_t i = 0; i < n; i++)
+            m->row[i] = P->kind[i] == LUB_FLUID && !(fix && fix[i]) ? 0 : -1;
+        int ncols, nglobal;
+        const int nf = number_rows(m, &ncols, &nglobal);
+        begin_rows(m, nf, ncols, nglobal);
 #pragma omp parallel for schedule(static)
         for (int r = 0; r < nf; r++) {
             size_t i = (size_t)m->prow[r];
@@ -505,6 +558,9 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
             for (size_t i = 0; i < n; i++)
                 if (P->kind[i] == LUB_FLUID && !(fix && fix[i]))
                     m->us[d][i] += dt * rinv * gold[d][i];
+    /* the halo's u*: its positions r* and the divergence of u* need them */
+    if (m->par)
+        for (int d = 0; d < dim; d++) lub_par_refresh(m->par, m->us[d], sizeof(double));
     lub_timer_stop(&m->tm, LUB_T_VISCOSITY);
     return 0;
 }
@@ -687,6 +743,12 @@ static void free_surface(lub_mps *m)
         ns += s;
     }
     m->st.nsurface = ns;
+    if (m->par) { /* the halo's flags are their owners' (the pressure rows' columns) */
+        lub_par_refresh(m->par, m->surface, sizeof *m->surface);
+        ns = 0;
+        for (size_t i = 0; i < m->par->nown; i++) ns += m->surface[i];
+        m->st.nsurface = (size_t)lub_par_sum_long((long)ns);
+    }
     if (prev) { /* this step's surface, for the next step's */
 #pragma omp parallel for schedule(static)
         for (size_t i = 0; i < n; i++) prev[i] = m->surface[i];
@@ -744,6 +806,58 @@ static size_t isolated_groups(lub_mps *m, int nu)
             m->surface[i] = 1;
             count++;
         }
+    }
+    return count;
+}
+
+/* isolated_groups on several ranks (m->par), exactly: "connected to a Dirichlet particle"
+ * spreads from the anchored rows over the matrix's graph, within the rank's rows and across
+ * the slab boundaries through the halo's copy of the flag (m->conn, refreshed from its
+ * owners), until no rank's halo copy changes: a few rounds, one per slab boundary a path of
+ * connection crosses (the flag only ever turns on, so the rounds end).  The rows left
+ * unconnected are the groups: marked as surface particles, their number returned (this
+ * rank's; the caller sums them).  Unlike the serial search, which explores at most
+ * ISOLATED_MAX rows from a few candidates, every group is found, whatever its size and
+ * however many ranks it spans; a rank cannot tell a large unconnected group from a
+ * connected one without the other ranks' rows. */
+static size_t isolated_groups_ranks(lub_mps *m, int nu, int ncols)
+{
+    const lub_par *d = m->par;
+    const lub_csr *A = &m->A;
+    const size_t nown = d->nown, n = nown + d->nhalo;
+    uint8_t *conn = m->conn;
+    int *queue = m->scratch;
+    memset(conn, 0, n);
+    for (int r = 0; r < nu; r++)
+        if (m->anchor[r]) conn[m->prow[r]] = 1;
+    for (;;) {
+        int head = 0, tail = 0;
+        for (int r = 0; r < nu; r++) { /* the seeds: anchored, or next to a connected halo */
+            const size_t i = (size_t)m->prow[r];
+            for (int k = A->row_ptr[r]; k < A->row_ptr[r + 1] && !conn[i]; k++)
+                if (A->col[k] >= nu && conn[m->prow[A->col[k]]]) conn[i] = 1;
+            if (conn[i]) queue[tail++] = r;
+        }
+        while (head < tail) {
+            const int s = queue[head++];
+            for (int k = A->row_ptr[s]; k < A->row_ptr[s + 1]; k++) {
+                const int c = A->col[k];
+                if (c < nu && !conn[m->prow[c]]) conn[m->prow[c]] = 1, queue[tail++] = c;
+            }
+        }
+        long before = 0, after = 0;
+        for (int c = nu; c < ncols; c++) before += conn[m->prow[c]];
+        lub_par_refresh(m->par, conn, 1);
+        for (int c = nu; c < ncols; c++) after += conn[m->prow[c]];
+        if (lub_par_sum_long(after != before) == 0) break;
+    }
+    size_t count = 0;
+    for (int r = 0; r < nu; r++) {
+        const size_t i = (size_t)m->prow[r];
+        if (conn[i]) continue;
+        if (count == 0) m->st.isolated_id = (unsigned long long)m->P->id[i];
+        m->surface[i] = 1;
+        count++;
     }
     return count;
 }
@@ -812,16 +926,16 @@ static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
     int retried = 0;
 assemble:
     lub_timer_start(&m->tm, LUB_T_ASSEMBLY);
-    int nu = 0;
     size_t nfix = 0;
     for (size_t i = 0; i < n; i++) {
         int unknown = P->kind[i] != LUB_DUMMY && !m->surface[i] && !(m->cav && m->cav[i] > 0);
         if (fix && fix[i] && P->kind[i] != LUB_DUMMY) unknown = 0, nfix++;
-        m->row[i] = unknown ? nu : -1;
-        if (unknown) m->prow[nu++] = (int)i;
+        m->row[i] = unknown ? 0 : -1;
     }
-    m->st.nunknowns = (size_t)nu;
-    if (nu > 0 && m->st.nsurface == 0 && nfix == 0 && alpha == 0) {
+    int ncols, nglobal;
+    const int nu = number_rows(m, &ncols, &nglobal);
+    m->st.nunknowns = (size_t)nglobal;
+    if (nglobal > 0 && m->st.nsurface == 0 && nfix == 0 && alpha == 0) {
         lub_timer_stop(&m->tm, LUB_T_ASSEMBLY);
         snprintf(msg, msgsize,
                  "the pressure equation has no Dirichlet particle (no free surface) and "
@@ -829,7 +943,7 @@ assemble:
                  "for a closed domain");
         return -1;
     }
-    begin_rows(m, nu);
+    begin_rows(m, nu, ncols, nglobal);
 #pragma omp parallel for schedule(static)
     for (int r = 0; r < nu; r++) {
         size_t i = (size_t)m->prow[r];
@@ -863,7 +977,20 @@ assemble:
     }
     lub_csr_finish(&m->A);
     if (alpha == 0 && !retried) {
-        const size_t k = isolated_groups(m, nu);
+        size_t k = m->par ? isolated_groups_ranks(m, nu, ncols) : isolated_groups(m, nu);
+        /* every rank assembles again when one found a group (the rows are numbered over all) */
+        if (m->par) {
+            if (lub_par_first(k > 0) >= 0) {
+                /* the first rank's first particle is the one named */
+                const int who = lub_par_first(k > 0);
+                char idtext[32];
+                snprintf(idtext, sizeof idtext, "%llu", m->st.isolated_id);
+                lub_par_bcast_text(idtext, sizeof idtext, who);
+                m->st.isolated_id = strtoull(idtext, NULL, 10);
+                lub_par_refresh(m->par, m->surface, sizeof *m->surface);
+            }
+            k = (size_t)lub_par_sum_long((long)k);
+        }
         if (k > 0) {
             m->st.nisolated = k;
             m->st.nsurface += k;
@@ -920,10 +1047,10 @@ assemble:
     const double *b = m->b;
     double *x = m->x;
     lub_solve_status s = LUB_SOLVE_OK;
-    if (nu > 0 && lsmps) {
+    if (nglobal > 0 && lsmps) {
         double *bb = m->b;
         s = lsmps_solve(m, &m->psolver, 1, &bb, &x, &m->st.p);
-    } else if (nu > 0) {
+    } else if (nglobal > 0) {
         s = lub_linsolver_solve(&m->psolver, &m->A, 1, &b, &x, &m->st.p);
     }
     lub_timer_stop(&m->tm, LUB_T_PSOLVE);
@@ -947,10 +1074,13 @@ assemble:
             if (cav) cav[i] = 0;
             continue;
         }
-        double p = m->row[i] >= 0 ? m->x[m->row[i]] : 0.0;
+        const int r = m->row[i];
+        double p = r >= 0 && r < nu ? m->x[r] : 0.0;
         P->p[i] = (clip && p < 0) ? 0.0 : p;
-        if (cav && m->row[i] >= 0) cav[i] = p < 0;
+        if (cav && r >= 0) cav[i] = p < 0;
     }
+    /* the halo's pressures: the gradient and the cavitation release read them */
+    if (m->par) lub_par_refresh(m->par, P->p, sizeof *P->p);
     if (cav) {
         /* release the held particles whose row would now give them a positive pressure */
 #pragma omp parallel for schedule(static)
@@ -1009,11 +1139,11 @@ static void wrap(lub_mps *m)
 lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize)
 {
     lub_particles *P = m->P;
-    const size_t n = P->n;
     const int dim = m->dim;
     *bad = -1;
     msg[0] = '\0';
     memset(&m->st, 0, sizeof m->st);
+    lub_par *par = m->par;
 
     /* 1. neighbours at r^k; the particles sorted every reorder_interval steps */
     /* the reorder schedule follows the global step, so that a restarted run sorts at the
@@ -1022,12 +1152,24 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
      * update keeps the pairs within re */
     int rebuild = !m->built || m->c.list_l0 * m->l0 > m->re;
     m->built = 1;
+    lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
+    /* several ranks: the owned particles that left the slab to their owner, then (sorted
+     * among themselves) the halo after them; the lists are new every step */
+    if (par) {
+        if (par->interval > 0 && m->steps % par->interval == 0)
+            lub_par_rebalance(par, P, par->imbalance); /* new cuts: the migration moves them */
+        lub_par_migrate(par, P);
+    }
     if (m->c.reorder_interval > 0 && m->steps % m->c.reorder_interval == 0) {
-        lub_timer_start(&m->tm, LUB_T_NEIGHBOUR);
         lub_mps_reorder(m);
-        lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
         rebuild = 1;
     }
+    if (par) {
+        lub_par_halo(par, P);
+        rebuild = 1;
+    }
+    lub_timer_stop(&m->tm, LUB_T_NEIGHBOUR);
+    const size_t n = P->n;
     /* walls and dummies move with their patch velocity (unless a model set it: patch_moved) */
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++)
@@ -1039,7 +1181,10 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     double g[3] = {m->c.g[0], m->c.g[1], m->c.g[2]};
     int body = m->c.gravity;
     if (m->hooks.forces && m->hooks.forces(m->hooks.ctx, m, dt, g)) body = 1;
-    if (viscosity(m, dt, g, body, msg, msgsize)) return LUB_STEP_SOLVE_FAILED;
+    if (viscosity(m, dt, g, body, msg, msgsize)) {
+        if (par) P->n = par->nown; /* every rank fails together: the solve is theirs */
+        return LUB_STEP_SOLVE_FAILED;
+    }
     /* the models' per-particle forces (surface tension), explicit at r^k */
     lub_mps_particle_forces(m, dt, m->us);
 
@@ -1074,7 +1219,10 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     lub_timer_stop(&m->tm, LUB_T_ASSEMBLY);
 
     /* 6. pressure */
-    if (pressure(m, dt, msg, msgsize)) return LUB_STEP_SOLVE_FAILED;
+    if (pressure(m, dt, msg, msgsize)) {
+        if (par) P->n = par->nown;
+        return LUB_STEP_SOLVE_FAILED;
+    }
 
     /* 7. gradient, 8. correction (T-16, T-17); a fixed-band particle keeps u* (given) */
     lub_timer_start(&m->tm, LUB_T_GRADIENT);
@@ -1103,11 +1251,25 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     }
     lub_timer_stop(&m->tm, LUB_T_GRADIENT);
 
-    /* 9. the models' corrections (collision), periodic wrap, checks */
+    /* 9. the models' corrections (collision), periodic wrap, checks; on several ranks, of
+     * the owned particles (the halo, whose sums missed its far neighbours, is dropped) */
     if (m->hooks.after_correction) m->hooks.after_correction(m->hooks.ctx, m, dt);
     lub_timer_start(&m->tm, LUB_T_OTHER);
+    if (par) P->n = par->nown;
     wrap(m);
     lub_step_status s = lub_mps_check(m, dt, bad, msg, msgsize);
+    if (par) { /* every rank stops with the first failing rank's status and message */
+        const int who = lub_par_first(s != LUB_STEP_OK);
+        if (who >= 0) {
+            char text[1024];
+            snprintf(text, sizeof text, "%d %s", (int)s, msg);
+            lub_par_bcast_text(text, sizeof text, who);
+            char *rest = NULL;
+            s = (lub_step_status)strtol(text, &rest, 10);
+            snprintf(msg, msgsize, "%s", rest && *rest == ' ' ? rest + 1 : text);
+            if (who != par->rank) *bad = -1;
+        }
+    }
     m->st.umax = lub_mps_max_speed(m);
     lub_timer_stop(&m->tm, LUB_T_OTHER);
     m->iterations[0] += m->st.p.iterations;

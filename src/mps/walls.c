@@ -316,5 +316,5 @@ double lub_mps_max_speed(const lub_mps *m)
         for (int d = 0; d < m->dim; d++) s += P->u[d][i] * P->u[d][i];
         if (s > u2) u2 = s;
     }
-    return sqrt(u2);
+    return m->par ? lub_par_max(sqrt(u2)) : sqrt(u2); /* several ranks: of all */
 }

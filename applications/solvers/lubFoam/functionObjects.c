@@ -269,6 +269,11 @@ static int wall_pressure_resume_state(fo *o, lubfoam_run *r)
 
 static void wall_pressure(fo *o, lubfoam_run *r);
 
+int lubfoam_functions_count(const lubfoam_functions *f)
+{
+    return f ? f->n : 0;
+}
+
 lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
 {
     static const char *const types[] = {"totals", "wallPressure", "wallLoad", NULL};

@@ -284,11 +284,22 @@ static void run_free(lubfoam_run *r, lubfoam_functions *fos)
 /* Cost summary on the log and in postProcessing/cost/<startTime>/cost.dat. */
 static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, double vit_sum)
 {
-    double ps = (double)r->P.n * (double)steps;
+    const size_t np = r->parallel ? r->par.ntotal : r->P.n;
+    double ps = (double)np * (double)steps;
     double us = ps > 0 ? 1e6 * wall / ps : 0;
     lub_message("Cost: %ld steps, %zu particles, %.6g particle-steps in %.3f s wall: "
-                "%.4g us per particle-step (%d threads)",
-                steps, r->P.n, ps, wall, us, omp_get_max_threads());
+                "%.4g us per particle-step (%d threads%s)",
+                steps, np, ps, wall, us, omp_get_max_threads(), r->parallel ? " per rank" : "");
+    if (r->parallel) {
+        /* the exchanges' time on the rank that spent most in them; rank 0's phases below */
+        const double comm = lub_par_max(r->par.seconds);
+        const double mig = lub_par_sum((double)r->par.nmigrated);
+        lub_message("  %d ranks: communication (halo, migration, gathers) %.3f s, %.1f%% of the "
+                    "wall time (the most of any rank); %.0f particles migrated; %ld "
+                    "re-balancing cuts; rank 0's phases:",
+                    r->par.size, comm, wall > 0 ? 100 * comm / wall : 0.0, mig, r->par.nbalanced);
+    }
+    if (!lubfoam_writer_rank(r)) return;
     for (int k = 0; k < LUB_T_COUNT; k++)
         lub_message("  %-16s %10.3f s  %5.1f%%", lub_mps_phase_names[k], phase_seconds(r, k),
                     wall > 0 ? 100 * phase_seconds(r, k) / wall : 0.0);
@@ -308,7 +319,7 @@ static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, 
     enum { NFIXED = 8 };
     double row[NFIXED + LUB_T_COUNT] = {wall,
                                         (double)steps,
-                                        (double)r->P.n,
+                                        (double)np,
                                         ps,
                                         us,
                                         (double)omp_get_max_threads(),
@@ -347,6 +358,15 @@ int main(int argc, char **argv)
             "  startFrom: startTime over the results of an earlier run overwrites each time\n"
             "  folder and table the run writes again and leaves the others (the log warns,\n"
             "  listing them): lubClean removes them first, startFrom: latestTime continues.\n"
+            "  -parallel runs on the processes of 'mpirun -np N lubFoam -parallel' (a build\n"
+            "  with MPI: make MPI=1, the default with PETSc): system/decomposeParDict.yaml\n"
+            "  gives numberOfSubdomains (= N), the slabs' axis and their re-balancing; every\n"
+            "  rank reads the dictionaries and particles, keeps its slab and a halo of its\n"
+            "  neighbours' particles, the pressure (and implicit viscosity) is solved by\n"
+            "  PETSc over all ranks (solver: petsc in system/solution.yaml), rank 0 writes\n"
+            "  the time folders a serial run writes and the log.  Models other than gravity\n"
+            "  and movingWalls, fluid type mph, LSMPS Laplacians and function objects are\n"
+            "  refused (exit 1).\n"
             "  -dryRun reads and checks every dictionary and the start particles, prints the\n"
             "  start-up figures (particles, schemes, models, Courant and diffusion numbers,\n"
             "  multi-resolution checks), runs nothing and writes nothing.\n"
@@ -358,17 +378,23 @@ int main(int argc, char **argv)
                         "system/schemes.yaml\nsystem/solution.yaml (optional)\n"
                         "constant/transportProperties.yaml\nconstant/models.yaml\n"
                         "system/reynoldsRefDict.yaml (optional: the start-up check of "
-                        "resolution levels)",
+                        "resolution levels)\nsystem/decomposeParDict.yaml (-parallel)",
         .has_case = 1,
         .min_args = 0,
         .max_args = 0,
     };
-    int dry_run = 0;
+    int dry_run = 0, parallel = 0;
     lub_option opts[] = {{"-dryRun", NULL,
                           "check the case and print the start-up figures; run nothing, write "
                           "nothing",
                           LUB_OPT_FLAG, &dry_run},
+                         {"-parallel", NULL,
+                          "run on the processes of mpirun -np N (system/decomposeParDict.yaml)",
+                          LUB_OPT_FLAG, &parallel},
                          {0}};
+    /* MPI first, before anything reads the arguments (mpirun may add its own) */
+    lub_set_program(info.name);
+    if (lubfoam_wants_parallel(argc, argv)) lub_par_start(&argc, &argv);
     lub_args a;
     lub_args_parse(&a, argc, argv, &info, opts);
     /* the machine's load, read before this program starts its OpenMP threads: the runnable
@@ -381,7 +407,7 @@ int main(int argc, char **argv)
     memset(&r, 0, sizeof r);
     char path[LUB_PATH_MAX];
     lub_case_open(&r.cs, a.case_dir);
-    lub_case_clean(&r.cs);
+    if (lub_par_rank() == 0) lub_case_clean(&r.cs); /* one rank clears the leftovers */
     lub_control_read(&r.ctl, lub_case_path(&r.cs, path, "system/controlDict.yaml"));
     lub_geometry geo;
     lub_geometry_read(&geo, lub_case_path(&r.cs, path, "system/particleGenDict.yaml"));
@@ -401,6 +427,8 @@ int main(int argc, char **argv)
     print_header(&r, load_average, others_running);
     check_limits(&r, &geo);
     lubfoam_check_levels(&r, &geo);
+    if (parallel) lubfoam_parallel_setup(&r, &geo, lubfoam_functions_count(fos));
+    lub_par_startup_done(); /* from here, a rank's error is its own */
     r.scene.geo = NULL;
     lub_geometry_free(&geo);
 
@@ -416,6 +444,7 @@ int main(int argc, char **argv)
                     signal_name(stop_signal));
     else if (!dry_run)
         lubfoam_functions_start(fos, &r);
+    if (r.parallel) stop_signal = (sig_atomic_t)lub_par_max(stop_signal); /* all stop, or none */
     const int run_loop = !nothing_to_run && !stop_signal && !dry_run;
     if (run_loop) lubfoam_output_init(&r);
 
@@ -440,10 +469,13 @@ int main(int argc, char **argv)
                     "nothing run, nothing written",
                     r.start_name);
         run_free(&r, fos);
+        lubfoam_parallel_free(&r);
         return LUB_EXIT_OK;
     }
 
-    const int tty = isatty(STDOUT_FILENO);
+    /* no progress bar in a parallel run: Open MPI gives the ranks a terminal of its own
+     * whatever mpirun's output is (a log file) */
+    const int tty = isatty(STDOUT_FILENO) && !r.parallel;
     const double wall0 = lub_wtime();
     long steps = 0, last_write_step = -1;
     double pit_sum = 0, vit_sum = 0, last_bar = 0;
@@ -473,9 +505,11 @@ int main(int argc, char **argv)
         if (s != LUB_STEP_OK) {
             if (tty) fputc('\n', stdout);
             fflush(stdout);
-            fprintf(stderr, "lubFoam: error: step %ld (t = %.9g s): %s\n", r.step + nr,
-                    r.t + nr * r.dt, msg);
-            fprintf(stderr, "lubFoam: the last good state is the newest time folder\n");
+            if (lubfoam_writer_rank(&r)) { /* -parallel: every rank has the message */
+                fprintf(stderr, "lubFoam: error: step %ld (t = %.9g s): %s\n", r.step + nr,
+                        r.t + nr * r.dt, msg);
+                fprintf(stderr, "lubFoam: the last good state is the newest time folder\n");
+            }
             status = LUB_EXIT_RUN;
             break;
         }
@@ -493,7 +527,7 @@ int main(int argc, char **argv)
         double umax, co = lub_scene_courant(&r.scene, r.dt, &umax);
         for (int k = 0; k < r.scene.nlevels && !warned_isolated; k++) {
             const lub_mps *mk = r.scene.level[k];
-            if (mk->st.nisolated > 0) {
+            if (mk->st.nisolated > 0 && lubfoam_writer_rank(&r)) { /* all ranks' count */
                 lub_warning("step %ld: %zu particle(s) squeezed into groups that touch no "
                             "surface particle (first: id %llu), where the pressure equation "
                             "(alpha = 0) is singular: taken as surface particles (p = 0), "
@@ -502,7 +536,8 @@ int main(int argc, char **argv)
                 warned_isolated = 1;
             }
         }
-        if (!r.ctl.adjust_time_step && co > r.ctl.max_courant && !warned_courant) {
+        if (!r.ctl.adjust_time_step && co > r.ctl.max_courant && !warned_courant &&
+            lubfoam_writer_rank(&r)) {
             lub_warning("step %ld: Courant number %.3g exceeds maxCourant %g (u_max %g m/s)",
                         r.step, co, r.ctl.max_courant, umax);
             warned_courant = 1;
@@ -514,6 +549,10 @@ int main(int argc, char **argv)
         for (int j = 0; j < nr && !due; j++)
             due = lub_control_write_due(&r.ctl, r.write_origin, r.t - j * r.dt, r.write_origin_step,
                                         r.step - j, r.dt);
+        if (r.parallel) { /* a signal to one rank (mpirun forwards them) is every rank's */
+            stop_signal = (sig_atomic_t)lub_par_max(stop_signal);
+            write_signal = (sig_atomic_t)lub_par_max(write_signal);
+        }
         const int write_now = write_signal;
         if (due || finished || stop_signal || write_now) {
             lub_timer_start(run_timers(&r), LUB_T_OUTPUT);
@@ -551,6 +590,7 @@ int main(int argc, char **argv)
     if (run_loop) lub_scene_summary(&r.scene, r.t);
     if (run_loop) lubfoam_output_free(&r);
     run_free(&r, fos);
+    lubfoam_parallel_free(&r);
     if (status == LUB_EXIT_OK) lub_message("End");
     return status;
 }

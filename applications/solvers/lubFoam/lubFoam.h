@@ -10,6 +10,7 @@
 #include "models/model.h"
 #include "particles/particles_io.h"
 #include "mps/mps.h"
+#include "parallel/par.h"
 
 /* Run state the writers need. */
 typedef struct {
@@ -33,7 +34,26 @@ typedef struct {
     long write_origin_step;
     lub_particles_writer writer; /* id-order buffers for every particle the run can hold */
     lub_xdmf_series series;      /* the index of <case>/particles.xdmf */
+    /* -parallel (lubFoamParallel.c): P holds this rank's slab; the output gathers all
+     * particles into G on rank 0, which writes the time folders */
+    int parallel;
+    lub_par par;
+    lub_particles G;
 } lubfoam_run;
+
+/* -parallel on the command line (MPI is started before the arguments are parsed). */
+int lubfoam_wants_parallel(int argc, char **argv);
+/* -parallel: system/decomposeParDict.yaml against mpirun's process count, the models and
+ * solvers refused that are not parallel yet (exit 1, naming them: nfunctions, the function
+ * objects, are), then this rank's slab kept and the solver told (after the scene is built
+ * on all particles). */
+void lubfoam_parallel_setup(lubfoam_run *r, const lub_geometry *geo, int nfunctions);
+void lubfoam_parallel_free(lubfoam_run *r);
+/* Rank 0 writes (1 in a serial run). */
+static inline int lubfoam_writer_rank(const lubfoam_run *r)
+{
+    return !r->parallel || r->par.rank == 0;
+}
 
 /* Start time folder per controlDict (startFrom), reading particles and uniform/state.yaml. */
 void lubfoam_read_start(lubfoam_run *r);
@@ -71,5 +91,7 @@ void lubfoam_functions_write(lubfoam_functions *f, lubfoam_run *r);
  * it exactly. */
 void lubfoam_functions_write_state(lubfoam_functions *f, const lubfoam_run *r, const char *dir);
 void lubfoam_functions_free(lubfoam_functions *f);
+/* The number of function objects. */
+int lubfoam_functions_count(const lubfoam_functions *f);
 
 #endif

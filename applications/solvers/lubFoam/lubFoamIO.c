@@ -148,14 +148,16 @@ static void write_state(const lubfoam_run *r, const char *dir)
 
 void lubfoam_output_init(lubfoam_run *r)
 {
+    if (!lubfoam_writer_rank(r)) return;
     lub_case_clean(&r->cs);
-    lub_particles_writer_init(&r->writer, r->P.cap);
+    lub_particles_writer_init(&r->writer, r->parallel ? r->par.ntotal : r->P.cap);
     r->writer.sync_dir = 0; /* into temporary time folders, synced by lub_timedir_commit */
     lub_xdmf_series_scan(&r->series, &r->cs);
 }
 
 void lubfoam_output_free(lubfoam_run *r)
 {
+    if (!lubfoam_writer_rank(r)) return;
     lub_particles_writer_free(&r->writer);
     lub_xdmf_series_free(&r->series);
 }
@@ -166,12 +168,24 @@ void lubfoam_write(lubfoam_run *r, lubfoam_functions *fos)
     lub_time_name(r->t, r->ctl.time_precision, name, sizeof name);
     r->P.time = r->t;
     r->P.step = r->step;
+    /* -parallel: every rank's particles to rank 0, which writes the file a serial run
+     * writes (the writer puts them in id order) */
+    const lub_particles *W = &r->P;
+    if (r->parallel) {
+        if (r->G.cap == 0 && r->par.rank == 0) {
+            lub_particles_init(&r->G, r->P.dim, r->par.ntotal);
+            r->G.nextra = 0;
+        }
+        lub_par_gather(&r->par, &r->P, &r->G);
+        W = &r->G;
+    }
+    if (!lubfoam_writer_rank(r)) return;
     lub_timedir_begin(&r->cs, name, dir);
-    lub_particles_writer_write(&r->writer, &r->P, dir);
+    lub_particles_writer_write(&r->writer, W, dir);
     write_state(r, dir);
     lubfoam_functions_write_state(fos, r, dir);
     lub_timedir_commit(&r->cs, name, dir);
-    lub_xdmf_series_put(&r->series, name, &r->P);
+    lub_xdmf_series_put(&r->series, name, W);
 
     if (r->nwritten == r->capwritten) {
         r->capwritten = r->capwritten ? 2 * r->capwritten : 16;

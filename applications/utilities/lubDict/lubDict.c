@@ -35,6 +35,7 @@
 #include "models/transport.h"
 #include "models/model.h"
 #include "mps/mps.h"
+#include "parallel/par.h"
 #include "reynolds/refcase.h"
 
 static const char *description =
@@ -66,9 +67,10 @@ static const char *description =
     "nSteps, which the next edit may add; an error the file had before) is a warning, and\n"
     "the file is written.  Checked, known by their place in a case:\n"
     "system/controlDict.yaml, particleGenDict.yaml, schemes.yaml, solution.yaml,\n"
-    "reynoldsRefDict.yaml, constant/transportProperties.yaml, models.yaml (schemes,\n"
-    "solution, models and reynoldsRefDict are read with the case's other dictionaries, as\n"
-    "the programs read them).  Not checked, and said so on standard error: the function\n"
+    "reynoldsRefDict.yaml, decomposeParDict.yaml, constant/transportProperties.yaml,\n"
+    "models.yaml (schemes, solution, models, reynoldsRefDict and decomposeParDict are\n"
+    "read with the case's other dictionaries, as the programs read them).  Not checked, and said "
+    "so on standard error: the function\n"
     "objects of controlDict (lubFoam -dryRun checks them), system/probeDict.yaml (probe\n"
     "checks it), any other file, an edit whose case has another dictionary the readers\n"
     "cannot read.  Values that need the particles or several dictionaries together (a\n"
@@ -154,6 +156,18 @@ static void read_reference(const char *file, const char *root)
     lub_refcase_free(&rc);
 }
 
+static void read_decompose(const char *file, const char *root)
+{
+    char path[LUB_PATH_MAX];
+    lub_case c;
+    lub_case_open(&c, root);
+    lub_geometry g;
+    lub_geometry_read(&g, lub_case_path(&c, path, "system/particleGenDict.yaml"));
+    lub_par_dict pd;
+    lub_par_read_dict(&pd, file, g.dim, 0);
+    lub_geometry_free(&g);
+}
+
 typedef struct {
     const char *rel;                                  /* place in a case */
     void (*read)(const char *file, const char *root); /* NULL: not checked here */
@@ -168,6 +182,7 @@ static const known_dict known[] = {
     {"system/solution.yaml", read_solver, NULL},
     {"constant/models.yaml", read_solver, NULL},
     {"system/reynoldsRefDict.yaml", read_reference, NULL},
+    {"system/decomposeParDict.yaml", read_decompose, NULL},
     {"system/probeDict.yaml", NULL, "probe reads its sampling sets when it runs: run probe"},
 };
 

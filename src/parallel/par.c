@@ -1,0 +1,634 @@
+/* lubkit parallel: slabs, halo and migration on MPI (see par.h).  Compiled with MPI's flags
+ * when the build has MPI (Makefile: MPI=1 defines LUB_HAVE_MPI for this file). */
+#include "parallel/par.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "core/error.h"
+#include "core/timer.h"
+#include "io/dict.h"
+
+static const char *const methods[] = {"slabs", NULL};
+static const char *const axes[] = {"auto", "x", "y", "z", NULL};
+
+void lub_par_read_dict(lub_par_dict *pd, const char *path, int dim, int nranks)
+{
+    lub_dict *dd = lub_dict_read_optional(path);
+    if (!dd)
+        lub_fatal("-parallel: no '%s': it gives numberOfSubdomains and the method "
+                  "(etc/templates/decomposeParDict.yaml)",
+                  path);
+    lub_node *root = lub_dict_root(dd);
+    lub_node *nsub = lub_dict_get(root, "numberOfSubdomains");
+    const long ns = lub_node_int(nsub, 1, 1L << 20);
+    if (nranks > 0 && ns != nranks)
+        lub_node_error(nsub,
+                       "numberOfSubdomains %ld, but %s %d process%s (mpirun -np %d): run "
+                       "mpirun -np %ld lubFoam -parallel, or set numberOfSubdomains: %d",
+                       ns, lub_par_under_mpirun() ? "mpirun started" : "not under mpirun:", nranks,
+                       nranks == 1 ? "" : "es", nranks, ns, nranks);
+    lub_dict_choice(root, "method", methods, 0);
+    lub_node *sl = lub_dict_map_or(root, "slabs");
+    const int ax = lub_dict_choice(sl, "axis", axes, 0);
+    if (ax > dim) lub_node_error(lub_dict_find(sl, "axis"), "slabs axis z in a %d-D case", dim);
+    lub_node *bl = lub_dict_map_or(root, "balance");
+    pd->axis = ax - 1;
+    pd->interval = lub_dict_int_or(bl, "interval", 0, 0, 1L << 40);
+    pd->imbalance = lub_dict_real_or(bl, "imbalance", 0.1, LUB_NONNEGATIVE);
+    lub_dict_finish(dd);
+    lub_dict_free(dd);
+}
+
+int lub_par_under_mpirun(void)
+{
+    return getenv("OMPI_COMM_WORLD_SIZE") || getenv("PMI_SIZE") || getenv("PMIX_RANK");
+}
+
+#ifndef LUB_HAVE_MPI
+
+int lub_par_available(void)
+{
+    return 0;
+}
+void lub_par_start(int *argc, char ***argv)
+{
+    (void)argc, (void)argv;
+    lub_fatal("-parallel: this lubkit was built without MPI (make MPI=0, or no Open MPI and "
+              "PETSc found: bin/installDeps, then make)");
+}
+int lub_par_started(void)
+{
+    return 0;
+}
+int lub_par_rank(void)
+{
+    return 0;
+}
+int lub_par_size(void)
+{
+    return 1;
+}
+void lub_par_startup_done(void) {}
+void lub_par_stop(void) {}
+double lub_par_sum(double v)
+{
+    return v;
+}
+double lub_par_max(double v)
+{
+    return v;
+}
+long lub_par_sum_long(long v)
+{
+    return v;
+}
+long lub_par_exscan(long v)
+{
+    (void)v;
+    return 0;
+}
+void lub_par_bcast_text(char *text, size_t size, int root)
+{
+    (void)text, (void)size, (void)root;
+}
+int lub_par_first(int flag)
+{
+    return flag ? 0 : -1;
+}
+void lub_par_barrier(void) {}
+#define NO_MPI(f) lub_bug(f " in a build without MPI");
+void lub_par_init(lub_par *d, int axis, double width, double lo, double hi, int periodic)
+{
+    (void)d, (void)axis, (void)width, (void)lo, (void)hi, (void)periodic;
+    NO_MPI("lub_par_init")
+}
+void lub_par_free(lub_par *d)
+{
+    (void)d;
+}
+int lub_par_longest_axis(const lub_particles *P)
+{
+    (void)P;
+    NO_MPI("lub_par_longest_axis")
+}
+size_t lub_par_decompose(lub_par *d, lub_particles *P)
+{
+    (void)d, (void)P;
+    NO_MPI("lub_par_decompose")
+}
+int lub_par_owner(const lub_par *d, double x)
+{
+    (void)d, (void)x;
+    return 0;
+}
+int lub_par_rebalance(lub_par *d, const lub_particles *P, double imbalance)
+{
+    (void)d, (void)P, (void)imbalance;
+    NO_MPI("lub_par_rebalance")
+}
+void lub_par_migrate(lub_par *d, lub_particles *P)
+{
+    (void)d, (void)P;
+    NO_MPI("lub_par_migrate")
+}
+void lub_par_halo(lub_par *d, lub_particles *P)
+{
+    (void)d, (void)P;
+    NO_MPI("lub_par_halo")
+}
+void lub_par_refresh(lub_par *d, void *a, size_t elsize)
+{
+    (void)d, (void)a, (void)elsize;
+    NO_MPI("lub_par_refresh")
+}
+void lub_par_gather(lub_par *d, const lub_particles *P, lub_particles *G)
+{
+    (void)d, (void)P, (void)G;
+    NO_MPI("lub_par_gather")
+}
+
+#else
+
+#include <mpi.h>
+
+static int started = 0, startup = 1, rank_ = 0, size_ = 1;
+static char rank_prefix[32];
+
+int lub_par_available(void)
+{
+    return 1;
+}
+
+/* The fatal-error hook (core/error.h): every rank's fatal error ends the job. */
+static void fatal_hook(int status, const char *msg)
+{
+    fflush(stdout);
+    if (startup && rank_ != 0) {
+        /* rank 0 does the same work on the same input and meets the same error: its
+         * MPI_Abort ends this process; only if it does not come is this rank's own */
+        const struct timespec ts = {0, 100000000};
+        for (int k = 0; k < 100; k++) nanosleep(&ts, NULL);
+    }
+    if ((startup && rank_ == 0) || size_ == 1)
+        fprintf(stderr, "%s: error: %s\n", lub_program(), msg);
+    else
+        fprintf(stderr, "%s: error: rank %d: %s\n", lub_program(), rank_, msg);
+    fflush(stderr);
+    if (size_ == 1) exit(status); /* no other rank to end (MPI is finalised at exit) */
+    MPI_Abort(MPI_COMM_WORLD, status);
+    exit(status);
+}
+
+static void stop_at_exit(void)
+{
+    int fin = 0;
+    MPI_Finalized(&fin);
+    if (!fin) MPI_Finalize();
+}
+
+void lub_par_start(int *argc, char ***argv)
+{
+    if (started) return;
+    if (MPI_Init(argc, argv) != MPI_SUCCESS) lub_fatal("-parallel: MPI_Init failed");
+    started = 1;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+    MPI_Comm_size(MPI_COMM_WORLD, &size_);
+    lub_set_fatal_hook(fatal_hook);
+    if (rank_ != 0) {
+        lub_set_quiet(1);
+        lub_set_warning_prefix(NULL);
+    }
+    /* PETSc, started later on MPI_COMM_WORLD, finalises at exit too (registered after this,
+     * so it runs first) */
+    atexit(stop_at_exit);
+}
+
+int lub_par_started(void)
+{
+    return started;
+}
+int lub_par_rank(void)
+{
+    return rank_;
+}
+int lub_par_size(void)
+{
+    return size_;
+}
+
+void lub_par_startup_done(void)
+{
+    if (!started) return;
+    startup = 0;
+    snprintf(rank_prefix, sizeof rank_prefix, "rank %d: ", rank_);
+    if (size_ > 1) lub_set_warning_prefix(rank_prefix);
+}
+
+void lub_par_stop(void)
+{
+    if (started) stop_at_exit();
+}
+
+double lub_par_sum(double v)
+{
+    double r = v;
+    if (started) MPI_Allreduce(&v, &r, 1, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+    return r;
+}
+double lub_par_max(double v)
+{
+    double r = v;
+    if (started) MPI_Allreduce(&v, &r, 1, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
+    return r;
+}
+long lub_par_sum_long(long v)
+{
+    long r = v;
+    if (started) MPI_Allreduce(&v, &r, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+    return r;
+}
+long lub_par_exscan(long v)
+{
+    long r = 0;
+    if (started) MPI_Exscan(&v, &r, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+    return rank_ == 0 ? 0 : r;
+}
+void lub_par_bcast_text(char *text, size_t size, int root)
+{
+    if (started) MPI_Bcast(text, (int)size, MPI_CHAR, root, MPI_COMM_WORLD);
+    text[size - 1] = '\0';
+}
+int lub_par_first(int flag)
+{
+    int r = flag ? rank_ : size_, m = r;
+    if (started) MPI_Allreduce(&r, &m, 1, MPI_INT, MPI_MIN, MPI_COMM_WORLD);
+    return m < size_ ? m : -1;
+}
+void lub_par_barrier(void)
+{
+    if (started) MPI_Barrier(MPI_COMM_WORLD);
+}
+
+/* ---- the decomposition ------------------------------------------------------------------ */
+
+void lub_par_init(lub_par *d, int axis, double width, double lo, double hi, int periodic)
+{
+    memset(d, 0, sizeof *d);
+    d->axis = axis;
+    d->width = width;
+    d->lo = lo;
+    d->periodic = periodic;
+    d->period = periodic ? hi - lo : 0.0;
+    d->rank = rank_;
+    d->size = size_;
+    d->cut = lub_calloc((size_t)size_ + 1, sizeof *d->cut);
+    int **a[] = {&d->scount, &d->sdispl,  &d->rcount, &d->rdispl,
+                 &d->mcount, &d->mrcount, &d->mdispl, &d->mrdispl};
+    for (size_t k = 0; k < sizeof a / sizeof *a; k++)
+        *a[k] = lub_calloc((size_t)size_, sizeof(int));
+}
+
+void lub_par_free(lub_par *d)
+{
+    free(d->cut);
+    free(d->scount), free(d->sdispl), free(d->rcount), free(d->rdispl);
+    free(d->mcount), free(d->mrcount), free(d->mdispl), free(d->mrdispl);
+    free(d->sidx);
+    free(d->sbuf);
+    free(d->rbuf);
+    free(d->coord);
+    memset(d, 0, sizeof *d);
+}
+
+int lub_par_longest_axis(const lub_particles *P)
+{
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < P->n; i++) {
+        if (P->kind[i] != LUB_FLUID) continue;
+        for (int k = 0; k < P->dim; k++) {
+            lo[k] = fmin(lo[k], P->x[k][i]);
+            hi[k] = fmax(hi[k], P->x[k][i]);
+        }
+    }
+    int axis = 0;
+    for (int k = 1; k < P->dim; k++)
+        if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
+    return axis;
+}
+
+int lub_par_owner(const lub_par *d, double x)
+{
+    int a = 0, b = d->size; /* the largest r with cut[r] <= x, cut[0] = -inf */
+    while (b - a > 1) {
+        const int m = (a + b) / 2;
+        if (d->cut[m] <= x)
+            a = m;
+        else
+            b = m;
+    }
+    return a;
+}
+
+static int cmp_double(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Move particle i to k (k <= i) in every array of P. */
+static void move_particle(lub_particles *P, size_t k, size_t i)
+{
+    if (k == i) return;
+    for (int c = 0; c < 3; c++) {
+        P->x[c][k] = P->x[c][i];
+        P->u[c][k] = P->u[c][i];
+    }
+    P->p[k] = P->p[i];
+    P->kind[k] = P->kind[i];
+    P->patch[k] = P->patch[i];
+    P->level[k] = P->level[i];
+    P->id[k] = P->id[i];
+    for (int e = 0; e < P->nextra; e++) P->extra[e].v[k] = P->extra[e].v[i];
+}
+
+/* The cuts at the quantiles of the n coordinates s (sorted here): rank r from the
+ * (r n / size)-th coordinate on; equal coordinates (a lattice's column) stay together, on
+ * the rank of their first. */
+static void cut_at_quantiles(lub_par *d, double *s, size_t n)
+{
+    qsort(s, n, sizeof *s, cmp_double);
+    d->cut[0] = -INFINITY;
+    d->cut[d->size] = INFINITY;
+    for (int r = 1; r < d->size; r++) {
+        const size_t k = (size_t)((double)r * (double)n / d->size);
+        d->cut[r] = n ? s[k < n ? k : n - 1] : 0.0;
+        if (d->cut[r] < d->cut[r - 1]) d->cut[r] = d->cut[r - 1];
+    }
+}
+
+size_t lub_par_decompose(lub_par *d, lub_particles *P)
+{
+    const size_t n = P->n;
+    const int a = d->axis;
+    free(d->coord);
+    d->coord = lub_malloc((n ? n : 1) * sizeof *d->coord);
+    for (size_t i = 0; i < n; i++) d->coord[i] = P->x[a][i];
+    cut_at_quantiles(d, d->coord, n);
+    size_t k = 0, most = 0;
+    size_t *count = lub_calloc((size_t)d->size, sizeof *count);
+    for (size_t i = 0; i < n; i++) {
+        const int o = lub_par_owner(d, P->x[a][i]);
+        count[o]++;
+        if (o == d->rank) move_particle(P, k++, i);
+    }
+    for (int r = 0; r < d->size; r++)
+        if (count[r] > most) most = count[r];
+    free(count);
+    P->n = k;
+    d->nown = k;
+    d->nhalo = 0;
+    d->ntotal = n;
+    return most;
+}
+
+static long displs(const int *count, int *displ, int size);
+
+int lub_par_rebalance(lub_par *d, const lub_particles *P, double imbalance)
+{
+    const double t0 = lub_wtime();
+    const double most = lub_par_max((double)d->nown), mean = (double)d->ntotal / d->size;
+    int recut = 0;
+    if (most > (1 + imbalance) * mean) {
+        int cnt = (int)d->nown;
+        MPI_Allgather(&cnt, 1, MPI_INT, d->mrcount, 1, MPI_INT, MPI_COMM_WORLD);
+        const long total = displs(d->mrcount, d->mrdispl, d->size);
+        if ((size_t)total != d->ntotal)
+            lub_bug("re-balancing: %ld particles on the ranks, %zu at the start", total, d->ntotal);
+        MPI_Allgatherv(P->x[d->axis], cnt, MPI_DOUBLE, d->coord, d->mrcount, d->mrdispl, MPI_DOUBLE,
+                       MPI_COMM_WORLD);
+        cut_at_quantiles(d, d->coord, d->ntotal);
+        d->nbalanced++;
+        recut = 1;
+    }
+    d->seconds += lub_wtime() - t0;
+    return recut;
+}
+
+/* ---- packing ---------------------------------------------------------------------------- */
+
+/* A particle as doubles: position, velocity, pressure, kind, patch, level, id (its bits),
+ * the extra fields. */
+static size_t record_doubles(const lub_particles *P)
+{
+    return 11 + (size_t)P->nextra;
+}
+
+static void pack(const lub_particles *P, size_t i, double *r)
+{
+    for (int c = 0; c < 3; c++) r[c] = P->x[c][i], r[3 + c] = P->u[c][i];
+    r[6] = P->p[i];
+    r[7] = P->kind[i];
+    r[8] = P->patch[i];
+    r[9] = P->level[i];
+    memcpy(&r[10], &P->id[i], sizeof(double));
+    for (int e = 0; e < P->nextra; e++) r[11 + e] = P->extra[e].v[i];
+}
+
+static void unpack(lub_particles *P, size_t i, const double *r)
+{
+    for (int c = 0; c < 3; c++) P->x[c][i] = r[c], P->u[c][i] = r[3 + c];
+    P->p[i] = r[6];
+    P->kind[i] = (uint8_t)r[7];
+    P->patch[i] = (uint16_t)r[8];
+    P->level[i] = (uint8_t)r[9];
+    memcpy(&P->id[i], &r[10], sizeof(double));
+    for (int e = 0; e < P->nextra; e++) P->extra[e].v[i] = r[11 + e];
+}
+
+static void *grow_buf(unsigned char **b, size_t *cap, size_t bytes)
+{
+    if (bytes > *cap) {
+        free(*b);
+        *cap = bytes + bytes / 2 + 64;
+        *b = lub_malloc(*cap);
+    }
+    return *b;
+}
+
+/* displacements from counts; returns the total */
+static long displs(const int *count, int *displ, int size)
+{
+    long t = 0;
+    for (int r = 0; r < size; r++) {
+        displ[r] = (int)t;
+        t += count[r];
+    }
+    return t;
+}
+
+static void need_capacity(const lub_particles *P, size_t n, const char *what)
+{
+    if (n > P->cap)
+        lub_fatal_run("%s: %zu particles on this rank exceed its capacity %zu (a slab holds "
+                      "more than the whole case had at the start?)",
+                      what, n, P->cap);
+}
+
+/* An MPI datatype of `size` bytes, contiguous (counts in particles, records of any size). */
+static MPI_Datatype record_type(size_t bytes)
+{
+    MPI_Datatype t;
+    MPI_Type_contiguous((int)bytes, MPI_BYTE, &t);
+    MPI_Type_commit(&t);
+    return t;
+}
+
+void lub_par_migrate(lub_par *d, lub_particles *P)
+{
+    const double t0 = lub_wtime();
+    const int a = d->axis, size = d->size;
+    const size_t nr = record_doubles(P), n = d->nown;
+    P->n = n;
+    memset(d->mcount, 0, (size_t)size * sizeof *d->mcount);
+    size_t nout = 0;
+    for (size_t i = 0; i < n; i++) {
+        const int o = lub_par_owner(d, P->x[a][i]);
+        if (o != d->rank) d->mcount[o]++, nout++;
+    }
+    displs(d->mcount, d->mdispl, size);
+    double *sb = grow_buf(&d->sbuf, &d->sbuf_cap, (nout ? nout : 1) * nr * sizeof(double));
+    /* pack the leavers by owner, keep the others in order */
+    int *fill = d->scount; /* free until the halo */
+    memset(fill, 0, (size_t)size * sizeof *fill);
+    size_t k = 0;
+    for (size_t i = 0; i < n; i++) {
+        const int o = lub_par_owner(d, P->x[a][i]);
+        if (o != d->rank) {
+            pack(P, i, sb + (size_t)(d->mdispl[o] + fill[o]++) * nr);
+        } else {
+            move_particle(P, k++, i);
+        }
+    }
+    MPI_Alltoall(d->mcount, 1, MPI_INT, d->mrcount, 1, MPI_INT, MPI_COMM_WORLD);
+    const long nin = displs(d->mrcount, d->mrdispl, size);
+    need_capacity(P, k + (size_t)nin, "migration");
+    double *rb = grow_buf(&d->rbuf, &d->rbuf_cap, (nin ? (size_t)nin : 1) * nr * sizeof(double));
+    MPI_Datatype t = record_type(nr * sizeof(double));
+    MPI_Alltoallv(sb, d->mcount, d->mdispl, t, rb, d->mrcount, d->mrdispl, t, MPI_COMM_WORLD);
+    MPI_Type_free(&t);
+    for (long q = 0; q < nin; q++) unpack(P, k + (size_t)q, rb + (size_t)q * nr);
+    d->nown = k + (size_t)nin;
+    d->nmigrated += nout;
+    P->n = d->nown;
+    d->seconds += lub_wtime() - t0;
+}
+
+/* Distance along the axis from x to slab r (0 inside), the period taken into account. */
+static double slab_distance(const lub_par *d, int r, double x)
+{
+    const double a = d->cut[r], b = d->cut[r + 1];
+    double best = INFINITY;
+    const int shifts = d->periodic ? 1 : 0;
+    for (int s = -shifts; s <= shifts; s++) {
+        const double y = x + s * d->period;
+        const double dist = y < a ? a - y : (y >= b ? y - b : 0.0);
+        if (dist < best) best = dist;
+    }
+    return best;
+}
+
+void lub_par_halo(lub_par *d, lub_particles *P)
+{
+    const double t0 = lub_wtime();
+    const int a = d->axis, size = d->size;
+    const size_t n = d->nown, nr = record_doubles(P);
+    P->n = n;
+    /* which owned particles each other rank needs: two passes (count, then list by rank) */
+    memset(d->scount, 0, (size_t)size * sizeof *d->scount);
+    for (size_t i = 0; i < n; i++)
+        for (int r = 0; r < size; r++)
+            if (r != d->rank && slab_distance(d, r, P->x[a][i]) < d->width) d->scount[r]++;
+    const long nsend = displs(d->scount, d->sdispl, size);
+    if ((size_t)nsend > d->sidx_cap) {
+        free(d->sidx);
+        d->sidx_cap = (size_t)nsend + (size_t)nsend / 2 + 16;
+        d->sidx = lub_malloc(d->sidx_cap * sizeof *d->sidx);
+    }
+    int *fill = d->mcount; /* free after the migration */
+    memset(fill, 0, (size_t)size * sizeof *fill);
+    for (size_t i = 0; i < n; i++)
+        for (int r = 0; r < size; r++)
+            if (r != d->rank && slab_distance(d, r, P->x[a][i]) < d->width)
+                d->sidx[d->sdispl[r] + fill[r]++] = (uint32_t)i;
+    double *sb =
+        grow_buf(&d->sbuf, &d->sbuf_cap, (nsend ? (size_t)nsend : 1) * nr * sizeof(double));
+    for (long q = 0; q < nsend; q++) pack(P, d->sidx[q], sb + (size_t)q * nr);
+    MPI_Alltoall(d->scount, 1, MPI_INT, d->rcount, 1, MPI_INT, MPI_COMM_WORLD);
+    const long nin = displs(d->rcount, d->rdispl, size);
+    need_capacity(P, n + (size_t)nin, "halo");
+    double *rb = grow_buf(&d->rbuf, &d->rbuf_cap, (nin ? (size_t)nin : 1) * nr * sizeof(double));
+    MPI_Datatype t = record_type(nr * sizeof(double));
+    MPI_Alltoallv(sb, d->scount, d->sdispl, t, rb, d->rcount, d->rdispl, t, MPI_COMM_WORLD);
+    MPI_Type_free(&t);
+    for (long q = 0; q < nin; q++) unpack(P, n + (size_t)q, rb + (size_t)q * nr);
+    d->nhalo = (size_t)nin;
+    P->n = n + (size_t)nin;
+    d->seconds += lub_wtime() - t0;
+}
+
+void lub_par_refresh(lub_par *d, void *a, size_t elsize)
+{
+    const double t0 = lub_wtime();
+    const long nsend = (long)d->sdispl[d->size - 1] + d->scount[d->size - 1];
+    unsigned char *sb = grow_buf(&d->sbuf, &d->sbuf_cap, (nsend ? (size_t)nsend : 1) * elsize);
+    const unsigned char *src = a;
+    for (long q = 0; q < nsend; q++)
+        memcpy(sb + (size_t)q * elsize, src + d->sidx[q] * elsize, elsize);
+    MPI_Datatype t = record_type(elsize);
+    /* straight into the halo's part of the array: the receive displacements are its order */
+    MPI_Alltoallv(sb, d->scount, d->sdispl, t, (unsigned char *)a + d->nown * elsize, d->rcount,
+                  d->rdispl, t, MPI_COMM_WORLD);
+    MPI_Type_free(&t);
+    d->seconds += lub_wtime() - t0;
+}
+
+void lub_par_gather(lub_par *d, const lub_particles *P, lub_particles *G)
+{
+    const double t0 = lub_wtime();
+    const size_t nr = record_doubles(P), n = d->nown;
+    const int size = d->size;
+    int cnt = (int)n;
+    MPI_Gather(&cnt, 1, MPI_INT, d->mrcount, 1, MPI_INT, 0, MPI_COMM_WORLD);
+    long total = 0;
+    if (d->rank == 0) total = displs(d->mrcount, d->mrdispl, size);
+    double *sb = grow_buf(&d->sbuf, &d->sbuf_cap, (n ? n : 1) * nr * sizeof(double));
+    for (size_t i = 0; i < n; i++) pack(P, i, sb + i * nr);
+    double *rb = NULL;
+    if (d->rank == 0)
+        rb = grow_buf(&d->rbuf, &d->rbuf_cap, (total ? (size_t)total : 1) * nr * sizeof(double));
+    MPI_Datatype t = record_type(nr * sizeof(double));
+    MPI_Gatherv(sb, cnt, t, rb, d->mrcount, d->mrdispl, t, 0, MPI_COMM_WORLD);
+    MPI_Type_free(&t);
+    if (d->rank == 0) {
+        if (G->cap < (size_t)total) lub_particles_reserve(G, (size_t)total);
+        G->dim = P->dim;
+        G->time = P->time;
+        G->step = P->step;
+        G->nlevels = P->nlevels;
+        memcpy(G->levels, P->levels, sizeof G->levels);
+        G->npatches = P->npatches;
+        memcpy(G->patch_names, P->patch_names, sizeof G->patch_names);
+        for (int e = 0; e < P->nextra; e++) lub_particles_extra(G, P->extra[e].name);
+        if (G->nextra != P->nextra)
+            lub_bug("gather: %d extra fields into %d", P->nextra, G->nextra);
+        for (long q = 0; q < total; q++) unpack(G, (size_t)q, rb + (size_t)q * nr);
+        G->n = (size_t)total;
+    }
+    d->seconds += lub_wtime() - t0;
+}
+
+#endif

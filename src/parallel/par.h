@@ -1,0 +1,148 @@
+/* lubkit parallel: a run on several MPI processes (ranks), `mpirun -np N lubFoam -parallel`
+ * (issue 31; the plan and its state: doc/parallel.md).
+ *
+ * Decomposition: slabs along one axis (system/decomposeParDict.yaml, method slabs).  Rank r
+ * owns the particles (fluid, wall and dummy) whose coordinate on the axis lies in
+ * [cut[r], cut[r+1]); the cuts are set once, at the start, from the particle counts (the
+ * quantiles of the coordinate: every rank holds about N / P particles).  Each rank keeps
+ * its owned particles first in its lub_particles (indices 0 .. nown-1) and, during a step,
+ * copies of the other ranks' particles within `width` of its slab (the halo, appended after
+ * them: nown .. nown+nhalo-1), so that every neighbour sum of an owned particle is complete.
+ *
+ *     lub_par_start(&argc, &argv);              first thing in main (MPI_Init)
+ *     lub_par_init(&d, axis, width, lo, hi, periodic_axis);
+ *     lub_par_decompose(&d, P);                 every rank holds all particles: keeps its own
+ *     each step (mps/step.c):
+ *         lub_par_migrate(&d, P);               owned particles that left the slab to their owner
+ *         lub_par_halo(&d, P);                  the halo, all fields; P->n = nown + nhalo
+ *         lub_par_refresh(&d, a, sizeof *a);    one field of the halo anew (after a phase)
+ *         ... P->n = d.nown at the end of the step
+ *     lub_par_gather(&d, P, &G);                all particles on rank 0 (output)
+ *
+ * A halo particle is taken from every rank whose slab lies within width of it (not only the
+ * adjacent ones: slabs narrower than the width are allowed), and in a periodic direction
+ * along the axis across the period, with its own coordinates: the neighbour search takes the
+ * minimum image.  Migration and halo exchange are all-to-all (MPI_Alltoallv): fine for the
+ * tens of ranks of a workstation or a small cluster; the neighbour-only exchange of the plan
+ * is for later.
+ *
+ * Errors: once started, a fatal error on any rank ends all (MPI_Abort with its exit status).
+ * While the ranks repeat the same start-up (reading the dictionaries and the particles:
+ * lub_par_startup_done not yet called), rank 0 prints the message and the other ranks wait
+ * for its abort (printing theirs only if it does not come within 10 s); after it, the rank
+ * that fails prints the message with its rank.  Messages (lub_message) come from rank 0 only.
+ *
+ * A build without MPI (make MPI=0) has the names: lub_par_available() is 0, lub_par_start
+ * is a fatal input error saying so, and the rest is never called.
+ */
+#ifndef LUB_PARALLEL_PAR_H
+#define LUB_PARALLEL_PAR_H
+
+#include <stddef.h>
+#include <stdint.h>
+
+#include "particles/particles.h"
+
+/* system/decomposeParDict.yaml (etc/templates/decomposeParDict.yaml):
+ *
+ *     numberOfSubdomains: 2          # = mpirun -np
+ *     method: slabs                  # the only one yet
+ *     slabs: { axis: auto }          # auto (the fluid's longest) | x | y | z
+ *     balance: { interval: 0, imbalance: 0.1 }   # re-cut every interval steps (0: never)
+ *                                    # when the fullest rank holds > (1 + imbalance) x mean
+ *
+ * Read from path for a dim-D case; nranks > 0: numberOfSubdomains must equal it (an error
+ * at its line naming both otherwise).  Fatal (exit 1) at file:line on bad input. */
+typedef struct {
+    int axis;         /* 0, 1, 2; -1: auto */
+    long interval;    /* balance.interval (0: never) */
+    double imbalance; /* balance.imbalance */
+} lub_par_dict;
+void lub_par_read_dict(lub_par_dict *pd, const char *path, int dim, int nranks);
+
+/* 1 when this build has MPI. */
+int lub_par_available(void);
+/* 1 when the process looks started by mpirun (Open MPI's or MPICH's environment). */
+int lub_par_under_mpirun(void);
+/* MPI_Init (and the fatal-error hook, rank 0's messages); fatal without MPI. */
+void lub_par_start(int *argc, char ***argv);
+/* 1 after lub_par_start */
+int lub_par_started(void);
+int lub_par_rank(void);
+int lub_par_size(void);
+/* The ranks' start-up (same work on the same input) is over: from now on a fatal error is
+ * the failing rank's own and it prints it ("rank k: ..."), and warnings come from every
+ * rank, prefixed. */
+void lub_par_startup_done(void);
+/* MPI_Finalize (at the normal end; a fatal error aborts instead). */
+void lub_par_stop(void);
+
+/* Collectives over all ranks (the value itself without MPI or before lub_par_start). */
+double lub_par_sum(double v);
+double lub_par_max(double v);
+long lub_par_sum_long(long v);
+/* The sum of v over the ranks below this one. */
+long lub_par_exscan(long v);
+/* Rank 0's text to every rank (size bytes, NUL-terminated). */
+void lub_par_bcast_text(char *text, size_t size, int root);
+/* The smallest rank with flag != 0, or -1 when no rank has it. */
+int lub_par_first(int flag);
+void lub_par_barrier(void);
+
+typedef struct {
+    int axis;          /* 0, 1, 2 */
+    double width;      /* halo: particles within width of another rank's slab */
+    int periodic;      /* the axis is periodic (period = hi - lo) */
+    double lo, period; /* the box along the axis */
+    int rank, size;
+    double *cut;   /* [size + 1]: slab r = [cut[r], cut[r+1]) */
+    size_t nown;   /* owned particles: P's first nown */
+    size_t nhalo;  /* halo particles after them (during a step) */
+    size_t ntotal; /* all ranks' particles (at the decomposition; migration keeps it) */
+    int *scount, *sdispl, *rcount, *rdispl; /* [size] the halo's counts, in particles */
+    uint32_t *sidx;                         /* owned particles sent to the halos, by rank */
+    size_t sidx_cap;
+    unsigned char *sbuf, *rbuf; /* packing buffers */
+    size_t sbuf_cap, rbuf_cap;
+    int *mcount, *mrcount, *mdispl, *mrdispl; /* migration counts */
+    double seconds;                           /* in communication (exchanges, gathers) */
+    size_t nmigrated;                         /* particles this rank sent away so far */
+    long interval;    /* re-balance every interval steps (0: never; set by the caller) */
+    double imbalance; /* when the fullest rank holds > (1 + imbalance) x the mean */
+    double *coord;    /* [ntotal] every rank's coordinates on the axis (re-balancing) */
+    long nbalanced;   /* re-cuts so far */
+} lub_par;
+
+/* Slabs of the axis (0, 1, 2) of the box [lo, hi] (periodic: the axis is periodic), halo
+ * width (the neighbour search's radius re (1 + skin) and a margin). */
+void lub_par_init(lub_par *d, int axis, double width, double lo, double hi, int periodic);
+void lub_par_free(lub_par *d);
+/* The longest axis of the fluid particles' bounding box (every rank holds all particles). */
+int lub_par_longest_axis(const lub_particles *P);
+/* Every rank holds all particles (read from the same file): the cuts at the quantiles of
+ * the axis coordinate, and P keeps this rank's particles (in their order).  Returns the
+ * number of particles of the most loaded rank. */
+size_t lub_par_decompose(lub_par *d, lub_particles *P);
+/* Re-balancing (P->n = nown): when the fullest rank holds more than (1 + imbalance) times
+ * the mean count, new cuts at the quantiles of all ranks' coordinates (an all-gather of
+ * them: O(N) per re-cut, fine every few tens of steps); lub_par_migrate then moves the
+ * particles.  Returns 1 when it re-cut.  Collective. */
+int lub_par_rebalance(lub_par *d, const lub_particles *P, double imbalance);
+/* The rank owning a coordinate on the axis. */
+int lub_par_owner(const lub_par *d, double x);
+/* P->n = nown on entry: owned particles whose coordinate left the slab go to their owner
+ * (every field, the extras included, appended there); nown updated.  Fatal (exit 2) when a
+ * rank's particles would exceed its capacity P->cap. */
+void lub_par_migrate(lub_par *d, lub_particles *P);
+/* P->n = nown on entry: the halo (every field of the other ranks' particles within width of
+ * this slab) appended; P->n = nown + nhalo.  Fatal (exit 2) beyond P->cap. */
+void lub_par_halo(lub_par *d, lub_particles *P);
+/* The halo's copy of one per-particle array a (elements of elsize bytes: 1, 2, 4 or 8), from
+ * the owners' values: a[nown + k] = the owner's a[i]. */
+void lub_par_refresh(lub_par *d, void *a, size_t elsize);
+/* All ranks' owned particles into G on rank 0 (G's capacity is grown; its extra fields are
+ * P's, by name), with P's time, step, levels and patches; other ranks: G untouched.
+ * Collective. */
+void lub_par_gather(lub_par *d, const lub_particles *P, lub_particles *G);
+
+#endif
