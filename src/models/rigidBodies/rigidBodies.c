@@ -607,6 +607,15 @@ static void rigid_header(const lub_model *m, const lub_scene *s)
                         rb->name, b->nplanes, b->kn, b->kt, b->cn, b->ct, b->mu, b->distance,
                         lub_body_dt_limit(b, STEPS_PER_CYCLE), STEPS_PER_CYCLE);
     }
+    lub_body b[MAX_BODIES];
+    for (int k = 0; k < r->n; k++) b[k] = r->body[k].b;
+    for (int q = 0; q < r->npairs; q++) {
+        const lub_body_pair *p = &r->pair[q];
+        lub_message("rigidBodies: contact of %s and %s: k_n %g, k_t %g, c_n %g, c_t %g, friction "
+                    "%g, distance %g m; dt <= %g s (%g steps per period)",
+                    r->body[p->a].name, r->body[p->b].name, p->kn, p->kt, p->cn, p->ct, p->mu,
+                    p->distance, lub_body_pair_dt_limit(p, b, STEPS_PER_CYCLE), STEPS_PER_CYCLE);
+    }
 }
 
 /* the contact force and torque on body k: its planes' and the other bodies' */
