@@ -314,10 +314,16 @@ static void sample_plane3(gen_ctx *c, const lub_wall *w)
             }
 }
 
-/* Radius of dummy layer j of a round wall: behind the surface. */
+/* Radius of layer j of a round wall: j > 0 the dummy layers behind the surface, j = 0 the
+ * wall, j < 0 the fluid layers in front of it (fluidLayers). */
 static double layer_radius(const lub_wall *w, int j, double l0)
 {
     return w->fluid_inside ? w->radius + j * l0 : w->radius - j * l0;
+}
+
+static int layer_kind(int j)
+{
+    return j > 0 ? LUB_DUMMY : j == 0 ? LUB_WALL : LUB_FLUID;
 }
 
 /* 2-D circle (or one ring of a 3-D cylinder, in the plane spanned by e1, e2 around cen). */
@@ -364,16 +370,17 @@ static int ring_inside(const lub_geometry *g, const double *cen, double r, int d
     return 1;
 }
 
-static void sample_cylinder(gen_ctx *c, const lub_wall *w)
+/* The layers j0..j1 of a cylinder (layer_radius) */
+static void sample_cylinder(gen_ctx *c, const lub_wall *w, int j0, int j1)
 {
     const lub_geometry *g = c->g;
     double l0 = g->levels[c->level].l0;
     if (g->dim == 2) {
         double e1[3] = {0, -1, 0}, e2[3] = {1, 0, 0};
-        for (int j = 0; j <= g->dummy_layers; j++) {
+        for (int j = j0; j <= j1; j++) {
             double r = layer_radius(w, j, l0);
             int full = !w->has_range && ring_inside(g, w->centre, r, 2);
-            sample_ring(c, w, w->centre, e1, e2, r, j ? LUB_DUMMY : LUB_WALL, full);
+            sample_ring(c, w, w->centre, e1, e2, r, layer_kind(j), full);
         }
         return;
     }
@@ -405,20 +412,21 @@ static void sample_cylinder(gen_ctx *c, const lub_wall *w)
     for (long i = i0; i <= i1; i++) {
         double t = t0 + i * step, cen[3];
         for (int d = 0; d < 3; d++) cen[d] = w->centre[d] + t * w->axis[d];
-        for (int j = 0; j <= g->dummy_layers; j++)
-            sample_ring(c, w, cen, e1, e2, layer_radius(w, j, l0), j ? LUB_DUMMY : LUB_WALL, 1);
+        for (int j = j0; j <= j1; j++)
+            sample_ring(c, w, cen, e1, e2, layer_radius(w, j, l0), layer_kind(j), 1);
     }
 }
 
-/* Sphere: rings of constant polar angle about the vertical axis, from the lowest point. */
-static void sample_sphere(gen_ctx *c, const lub_wall *w)
+/* Sphere: rings of constant polar angle about the vertical axis, from the lowest point;
+ * the layers j0..j1 (layer_radius). */
+static void sample_sphere(gen_ctx *c, const lub_wall *w, int j0, int j1)
 {
     const lub_geometry *g = c->g;
     double l0 = g->levels[c->level].l0;
     double up[3] = {0, 1, 0}, e1[3] = {1, 0, 0}, e2[3] = {0, 0, 1};
-    for (int j = 0; j <= g->dummy_layers; j++) {
+    for (int j = j0; j <= j1; j++) {
         double r = layer_radius(w, j, l0);
-        int kind = j ? LUB_DUMMY : LUB_WALL;
+        int kind = layer_kind(j);
         if (r <= 0.5 * l0) {
             if (r > 0) continue;
             push(c, w->centre, kind);
@@ -584,10 +592,10 @@ static void discretise_wall(gen_ctx *c, const lub_wall *w)
         sample_curve(c, w->pts, w->npts, w->fluid_above);
         break;
     case LUB_WALL_CYLINDER:
-        sample_cylinder(c, w);
+        sample_cylinder(c, w, 0, g->dummy_layers);
         break;
     case LUB_WALL_SPHERE:
-        sample_sphere(c, w);
+        sample_sphere(c, w, 0, g->dummy_layers);
         break;
     case LUB_WALL_POLYGON:
         sample_polygon(c, w);
@@ -936,6 +944,56 @@ static void jitter_point(const gen_ctx *c, long a, long b, long e, double *x)
 /* The generation: every level in what it owns (only < 0), or level `only` in [xlo, xhi]
  * (walls generated over [xlo - pad, xhi + pad] so that the fluid keeps its gap from the
  * walls just outside the range, then cut to the range). */
+/* The body-fitted fluid of the round walls with fluidLayers K: the surfaces k l0 out from
+ * the wall (k = 1..K), sampled as its dummy layers are, into c->pts after the nw wall
+ * points.  A point is kept where the lattice fluid would be (in a region, in the domain,
+ * behind no wall, 0.999 wallGap l0 from every wall and dummy point) and as far from the
+ * kept layers of the walls before; counted into rc. */
+static void fluid_layers(gen_ctx *c, size_t nw, double h, size_t *rc)
+{
+    const lub_geometry *g = c->g;
+    cell_grid cg;
+    grid_build(&cg, g, &c->pts.p, nw, h);
+    for (int i = 0; i < g->nwalls; i++) {
+        const lub_wall *w = &g->walls[i];
+        if (w->fluid_layers <= 0) continue;
+        const size_t others = c->pts.n; /* the layers of the walls before end here */
+        c->wall = i;
+        for (int k = 0; k < g->nlevels; k++) {
+            if (c->only >= 0 && k != c->only) continue;
+            c->level = k;
+            const size_t a = c->pts.n;
+            if (w->type == LUB_WALL_SPHERE)
+                sample_sphere(c, w, -w->fluid_layers, -1);
+            else
+                sample_cylinder(c, w, -w->fluid_layers, -1);
+            const double l0 = g->levels[k].l0, tol = 1e-6 * l0, gap = 0.999 * g->wall_gap * l0;
+            size_t m = a;
+            for (size_t p = a; p < c->pts.n; p++) {
+                const gen_pt q = c->pts.p[p];
+                int keep = 0;
+                for (int r = 0; r < g->nregions && !keep; r++)
+                    keep = in_region(g, &g->regions[r], q.x, tol);
+                for (int b = 0; b < g->nwalls && keep; b++)
+                    keep = !lub_wall_behind(&g->walls[b], q.x, g->dim, tol);
+                if (keep && gap > 0 && grid_find(&cg, q.x, gap, nw) >= 0) keep = 0;
+                for (size_t o = nw; o < others && keep; o++) {
+                    double s2 = 0;
+                    for (int d = 0; d < g->dim; d++)
+                        s2 += (c->pts.p[o].x[d] - q.x[d]) * (c->pts.p[o].x[d] - q.x[d]);
+                    keep = s2 >= gap * gap;
+                }
+                if (!keep) continue;
+                for (int r = 0; r < g->nregions; r++)
+                    if (in_region(g, &g->regions[r], q.x, tol)) rc[r]++;
+                c->pts.p[m++] = q;
+            }
+            c->pts.n = m;
+        }
+    }
+    grid_free(&cg);
+}
+
 static void discretise(const lub_geometry *g, lub_particles *P, int only, double xlo, double xhi,
                        size_t *region_counts)
 {
@@ -1004,11 +1062,14 @@ static void discretise(const lub_geometry *g, lub_particles *P, int only, double
             }
     }
 
-    /* fluid on each level's lattice */
-    grid_build(&cg, g, &c.pts.p, nw, fmax(lmax, gapmax));
+    /* the body-fitted fluid of round walls, then the fluid on each level's lattice, which
+     * keeps its distance from both */
     size_t *rc = lub_calloc(g->nregions ? (size_t)g->nregions : 1, sizeof *rc);
     c.xlo = xlo;
     c.xhi = xhi;
+    if (g->nregions) fluid_layers(&c, nw, fmax(lmax, gapmax), rc);
+    nw = c.pts.n;
+    grid_build(&cg, g, &c.pts.p, nw, fmax(lmax, gapmax));
     for (int k = 0; k < g->nlevels && g->nregions; k++) {
         if (only >= 0 && k != only) continue;
         double l0 = g->levels[k].l0, tol = 1e-6 * l0, gap = 0.999 * g->wall_gap * l0;

@@ -20,6 +20,12 @@
  * Fluid.  Lattice points inside a region, on the fluid side of every wall, and at least
  * 0.999 wallGap l0 from every wall and dummy particle (0.999 so that round-off does not remove
  * the lattice row exactly one l0 from a wall).  A region left without particles is an error.
+ * A cylinder or sphere with fluidLayers K has its first K rows of fluid body-fitted instead:
+ * on the offset surfaces R +- k l0 (k = 1..K) on its fluid side, sampled as its dummy layers,
+ * kept by the same rules (and as far from the layers of the walls before it), and the
+ * lattice fluid keeps 0.999 wallGap l0 from them too.  Against a curved wall the lattice
+ * leaves its first row 0.87 to 1.9 l0 from the wall particles, a gap across which the MPS
+ * viscous term couples the fluid to the wall too weakly: the fluid slips (methods.md §7.2).
  *
  * Jitter (g->jitter > 0, lub_geometry_discretise only).  Each fluid particle is then moved
  * from its lattice point by a displacement uniform in the disk (ball) of radius jitter l0, a

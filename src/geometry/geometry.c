@@ -93,6 +93,15 @@ static void read_cylinder(lub_wall *w, lub_node *m, int dim)
     read_range(w, m);
 }
 
+/* fluidLayers of a round wall: a 2-D cylinder must be a whole circle (its rings close) */
+static void read_fluid_layers(lub_wall *w, lub_node *m, int dim)
+{
+    w->fluid_layers = (int)lub_dict_int_or(m, "fluidLayers", 0, 0, 100);
+    lub_node *n = lub_dict_find(m, "fluidLayers");
+    if (n && w->fluid_layers > 0 && w->type == LUB_WALL_CYLINDER && dim == 2 && w->has_range)
+        lub_node_error(n, "wall '%s': fluidLayers needs a whole circle (no range)", w->name);
+}
+
 static void read_polyline(lub_wall *w, lub_node *m)
 {
     lub_node *pts = lub_dict_seq(m, "points");
@@ -238,6 +247,7 @@ static void read_wall(lub_geometry *g, lub_wall *w, const char *name, lub_node *
         break;
     case LUB_WALL_CYLINDER:
         read_cylinder(w, m, dim);
+        read_fluid_layers(w, m, dim);
         break;
     case LUB_WALL_POLYLINE:
         if (dim != 2) lub_node_error(tn, "wall '%s': type 'polyline' is 2-D only", name);
@@ -267,6 +277,7 @@ static void read_wall(lub_geometry *g, lub_wall *w, const char *name, lub_node *
         w->radius = lub_dict_real(m, "radius", LUB_POSITIVE);
         w->fluid_inside =
             lub_dict_choice(m, "fluid", (const char *const[]){"outside", "inside", NULL}, 0);
+        read_fluid_layers(w, m, dim);
         break;
     case LUB_WALL_POLYGON:
         if (dim != 2) lub_node_error(tn, "wall '%s': type 'polygon' is 2-D only", name);

@@ -32,6 +32,8 @@
  *     jitter:      { amplitude: 0.25, seed: 1 }   # disordered start (optional)
  *
  * cylinder: `centre` or `lowestPoint`; fluid `outside` (default) or `inside`.
+ * cylinder (2-D, no range; 3-D), sphere: `fluidLayers: K` (default 0) puts the first K rows
+ * of fluid on the surfaces k l0 (k = 1..K) out from the wall, body-fitted (discretise.h).
  * box, sphere: fluid `inside` or `outside` (box default inside: a tank; sphere outside).
  * segment, polyline (2-D): fluid `above` (default) or `below`; polyline x must increase.
  * polygon (2-D): a closed solid body (fluid outside): at least 3 vertices in any order
@@ -74,6 +76,7 @@ typedef struct {
     int fluid_above;       /* segment, polyline */
     int has_range;         /* cylinder arc / plane limited in x */
     double range[2];
+    int fluid_layers; /* cylinder, sphere: fluid on this many surfaces k l0 out (discretise.h) */
 } lub_wall;
 
 typedef enum { LUB_REGION_LAYER, LUB_REGION_BOX, LUB_REGION_BETWEEN } lub_region_type;

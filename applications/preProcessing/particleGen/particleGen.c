@@ -72,7 +72,9 @@ int main(int argc, char **argv)
         .description = "Walls get one layer of wall particles on their surface and dummyLayers "
                        "layers behind;\nfluid regions are filled on a square (cubic) lattice of "
                        "spacing l0 per level\n(with `jitter`, each fluid particle is then moved "
-                       "off it by up to amplitude l0).\nPrints counts per kind, patch and level.",
+                       "off it by up to amplitude l0);\na cylinder or sphere with fluidLayers K "
+                       "has its first K rows of fluid on the\nsurfaces R +- k l0 instead "
+                       "(body-fitted).\nPrints counts per kind, patch and level.",
         .dictionaries = "system/particleGenDict.yaml",
         .time_selection = 0,
         .has_case = 1,

@@ -71,10 +71,13 @@ static void mps_log(const lub_mps *m, double dt, double pit, char *buf, size_t s
 /* The force on the particles of a body's patch (rigidBodies; methods.md §7).
  *
  * Pressure: -p_i a_i on each wall particle i, the pressure the step solved there (T-9, T-10)
- * over the surface a_i it stands for.  Not the reaction of the pressure-gradient terms that
- * the wall particles put into their fluid neighbours' gradient (T-13, T-14): those are
- * differences p_j - p_i (or p_j - p_hat_i), blind to the pressure's level, and their sum
- * over a body scales with its perimeter times rho g re, not with its volume (Archimedes
+ * over the surface a_i it stands for, if a fluid particle lies within re of it: a wall
+ * particle without one has a pressure from the other walls' particles alone (two bodies
+ * within re of each other in air would push each other apart by their wall particles'
+ * number density, before they touch), which is no fluid's.  Not the reaction of the
+ * pressure-gradient terms that the wall particles put into their fluid neighbours' gradient (T-13,
+ * T-14): those are differences p_j - p_i (or p_j - p_hat_i), blind to the pressure's level, and
+ * their sum over a body scales with its perimeter times rho g re, not with its volume (Archimedes
  * would fail); nor do MPS's fluid-fluid gradient terms cancel in pairs (the difference form
  * is symmetric in i, j, not antisymmetric), so the fluid's own momentum is not conserved
  * either and no reaction could make fluid + body conserve it exactly.  The surface integral
@@ -104,10 +107,13 @@ static void mps_wall_forces(const lub_mps *m, int patch, double *const area[3],
     const lub_particles *P = m->P;
     const size_t n = P->n;
     const int dim = m->dim;
+    const lub_neighbours *nb = &m->nb;
     for (size_t i = 0; i < n; i++) {
-        const int on = P->kind[i] != LUB_FLUID && P->patch[i] == patch;
-        for (int d = 0; d < 3; d++)
-            f[d][i] = on && P->kind[i] == LUB_WALL && d < dim ? -P->p[i] * area[d][i] : 0.0;
+        int wetted = 0; /* a fluid particle within re: else p_i is no fluid's pressure */
+        if (P->kind[i] == LUB_WALL && P->patch[i] == patch)
+            for (size_t q = nb->start[i]; q < nb->end[i] && !wetted; q++)
+                wetted = nb->w[q] > 0 && P->kind[nb->j[q]] == LUB_FLUID;
+        for (int d = 0; d < 3; d++) f[d][i] = wetted && d < dim ? -P->p[i] * area[d][i] : 0.0;
     }
     if (m->c.viscosity == LUB_VISCOSITY_NONE) return;
     const double mu = m->c.rho * m->c.nu;
@@ -122,7 +128,6 @@ static void mps_wall_forces(const lub_mps *m, int patch, double *const area[3],
     for (int d = 0; d < dim; d++) dv *= m->l0;
     const double k = dv * lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, m->c.nu);
     const double gm = m->c.mirror_dummies ? 2.0 : 1.0;
-    const lub_neighbours *nb = &m->nb;
     for (size_t i = 0; i < n; i++) {
         if (P->kind[i] != LUB_FLUID) continue;
         for (size_t q = nb->start[i]; q < nb->end[i]; q++) {

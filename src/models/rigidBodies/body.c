@@ -7,6 +7,8 @@
 #endif
 #include <string.h>
 
+#include "core/error.h"
+
 void lub_body_circle(lub_body *b, double rho, double R)
 {
     b->mass = rho * M_PI * R * R;
@@ -209,28 +211,117 @@ static void axpy(lub_body_state *a, const lub_body_state *s, double h, const lub
     for (size_t i = 0; i < sizeof *s / sizeof(double); i++) pa[i] = ps[i] + h * pk[i];
 }
 
-void lub_body_step(const lub_body *b, lub_body_state *s, const double F[3], const double T[3],
-                   double dt)
+/* ---- contact between two bodies ---------------------------------------------------------- */
+
+/* 1/M of the translation and R^2/I of the rotation; 0 for a held body (infinitely heavy) */
+static double inverse_mass(const lub_body *b)
 {
-    lub_body_state k1, k2, k3, k4, y;
-    derivative(b, s, F, T, &k1);
-    axpy(&y, s, 0.5 * dt, &k1);
-    derivative(b, &y, F, T, &k2);
-    axpy(&y, s, 0.5 * dt, &k2);
-    derivative(b, &y, F, T, &k3);
-    axpy(&y, s, dt, &k3);
-    derivative(b, &y, F, T, &k4);
-    double *p = (double *)s;
-    const double *p1 = (double *)&k1, *p2 = (double *)&k2, *p3 = (double *)&k3, *p4 = (double *)&k4;
-    for (size_t i = 0; i < sizeof *s / sizeof(double); i++)
-        p[i] += dt / 6.0 * (p1[i] + 2.0 * p2[i] + 2.0 * p3[i] + p4[i]);
+    int held = b->hold[0] && b->hold[1] && (b->dim == 2 || b->hold[2]);
+    return held ? 0.0 : 1.0 / b->mass;
+}
+
+static double inverse_rotary(const lub_body *b)
+{
+    double I =
+        b->dim == 2 ? b->inertia[2] : fmin(b->inertia[0], fmin(b->inertia[1], b->inertia[2]));
+    return b->hold[3] ? 0.0 : b->radius * b->radius / I;
+}
+
+void lub_body_pair_damping(lub_body_pair *p, const lub_body *b, double zeta)
+{
+    const lub_body *A = &b[p->a], *B = &b[p->b];
+    const double in = inverse_mass(A) + inverse_mass(B);
+    const double it = in + inverse_rotary(A) + inverse_rotary(B);
+    p->cn = in > 0 ? 2.0 * zeta * sqrt(p->kn / in) : 0.0;
+    p->ct = it > 0 ? 2.0 * zeta * sqrt(p->kt / it) : 0.0;
+}
+
+double lub_body_pair_dt_limit(const lub_body_pair *p, const lub_body *b, double steps)
+{
+    const lub_body *A = &b[p->a], *B = &b[p->b];
+    const double in = inverse_mass(A) + inverse_mass(B);
+    const double it = in + inverse_rotary(A) + inverse_rotary(B);
+    double tn = in > 0 ? 2.0 * M_PI / sqrt(p->kn * in) : INFINITY;
+    double tt = it > 0 && p->kt > 0 ? 2.0 * M_PI / sqrt(p->kt * it) : INFINITY;
+    return fmin(tn, tt) / steps;
+}
+
+/* the pair's contact at states s: force f on b, torques, the tangential relative velocity vt
+ * of the contact points and the normal n; 1 while touching */
+static int pair_contact(const lub_body_pair *p, const lub_body *b, const lub_body_state *s,
+                        const double xi[3], double f[3], double ta[3], double tb[3], double vt[3],
+                        double n[3], double *delta)
+{
+    const lub_body *A = &b[p->a], *B = &b[p->b];
+    const lub_body_state *sa = &s[p->a], *sb = &s[p->b];
+    double d[3], ra[3], rb[3], va[3], vb[3], v[3];
+    for (int k = 0; k < 3; k++) d[k] = sb->x[k] - sa->x[k], f[k] = ta[k] = tb[k] = vt[k] = 0.0;
+    const double dist = sqrt(dot3(d, d));
+    for (int k = 0; k < 3; k++) n[k] = dist > 0 ? d[k] / dist : 0.0;
+    *delta = A->radius + B->radius + p->distance - dist;
+    /* touching from delta = 0 on: an impact that begins at a step's start begins there */
+    if (*delta < 0 || dist == 0) return 0;
+    for (int k = 0; k < 3; k++) ra[k] = A->radius * n[k], rb[k] = -B->radius * n[k];
+    lub_body_point_velocity(A, sa, ra, va);
+    lub_body_point_velocity(B, sb, rb, vb);
+    for (int k = 0; k < 3; k++) v[k] = vb[k] - va[k];
+    const double vn = dot3(v, n);
+    for (int k = 0; k < 3; k++) vt[k] = v[k] - vn * n[k];
+    const double fn = fmax(0.0, p->kn * *delta - p->cn * vn);
+    double ft[3], ftn = 0;
+    const double xin = dot3(xi, n);
+    for (int k = 0; k < 3; k++) {
+        ft[k] = -p->kt * (xi[k] - xin * n[k]) - p->ct * vt[k];
+        ftn += ft[k] * ft[k];
+    }
+    ftn = sqrt(ftn);
+    const double cap = p->mu * fn, scale = ftn > cap ? cap / ftn : 1.0;
+    double fa[3];
+    for (int k = 0; k < 3; k++) f[k] = fn * n[k] + scale * ft[k], fa[k] = -f[k];
+    cross(rb, f, tb);
+    cross(ra, fa, ta);
+    return 1;
+}
+
+int lub_body_pair_contact(const lub_body_pair *p, const lub_body *b, const lub_body_state *s,
+                          const double xi[3], double f[3], double ta[3], double tb[3],
+                          double *delta)
+{
+    double vt[3], n[3];
+    return pair_contact(p, b, s, xi, f, ta, tb, vt, n, delta);
+}
+
+/* ---- the step ------------------------------------------------------------------------------ */
+
+/* the derivatives of all bodies and pair springs at states y, springs xi */
+static void derivatives(int n, const lub_body *b, const lub_body_state *y, const double (*F)[3],
+                        const double (*T)[3], int np, const lub_body_pair *p, const double (*xi)[3],
+                        lub_body_state *k, double (*kxi)[3])
+{
+    double fx[LUB_BODY_MAX_BODIES][3], tx[LUB_BODY_MAX_BODIES][3];
+    for (int i = 0; i < n; i++)
+        for (int d = 0; d < 3; d++) fx[i][d] = F[i][d], tx[i][d] = T[i][d];
+    for (int q = 0; q < np; q++) {
+        double f[3], ta[3], tb[3], nn[3], del;
+        pair_contact(&p[q], b, y, xi[q], f, ta, tb, kxi[q], nn, &del);
+        for (int d = 0; d < 3; d++) {
+            fx[p[q].a][d] -= f[d], tx[p[q].a][d] += ta[d];
+            fx[p[q].b][d] += f[d], tx[p[q].b][d] += tb[d];
+        }
+    }
+    for (int i = 0; i < n; i++) derivative(&b[i], &y[i], fx[i], tx[i], &k[i]);
+}
+
+/* after the step: q renormalised, the springs of the planes and pairs kept tangential, zero
+ * without contact and at most mu F_n / k_t while sliding */
+static void finish(const lub_body *b, lub_body_state *s)
+{
     if (b->dim == 3) {
         const double nq = sqrt(dot3(s->q + 1, s->q + 1) + s->q[0] * s->q[0]);
         for (int a = 0; a < 4; a++) s->q[a] /= nq;
     } else {
         s->q[0] = cos(0.5 * s->angle), s->q[1] = s->q[2] = 0.0, s->q[3] = sin(0.5 * s->angle);
     }
-    /* the tangential springs: none without contact, at most mu F_n / k_t while sliding */
     for (int k = 0; k < b->nplanes; k++) {
         double f[3], t[3], vt[3];
         const double *n = b->plane[k].normal;
@@ -245,4 +336,63 @@ void lub_body_step(const lub_body *b, lub_body_state *s, const double F[3], cons
         if (b->kt > 0 && xm > lim)
             for (int d = 0; d < 3; d++) s->xi[k][d] *= lim / xm;
     }
+}
+
+static void finish_pair(const lub_body_pair *p, const lub_body *b, const lub_body_state *s,
+                        double xi[3])
+{
+    double f[3], ta[3], tb[3], vt[3], n[3], del;
+    const double zero[3] = {0, 0, 0};
+    if (!pair_contact(p, b, s, zero, f, ta, tb, vt, n, &del)) {
+        xi[0] = xi[1] = xi[2] = 0.0;
+        return;
+    }
+    const double xin = dot3(xi, n);
+    for (int d = 0; d < 3; d++) xi[d] -= xin * n[d];
+    const double fn = fmax(0.0, dot3(f, n)); /* with xi = 0: the normal force alone */
+    const double xm = sqrt(dot3(xi, xi)), lim = p->kt > 0 ? p->mu * fn / p->kt : 0.0;
+    if (xm > lim)
+        for (int d = 0; d < 3; d++) xi[d] = xm > 0 ? xi[d] * lim / xm : 0.0;
+}
+
+void lub_bodies_step(int n, const lub_body *b, lub_body_state *s, const double (*F)[3],
+                     const double (*T)[3], int np, const lub_body_pair *p, double (*xi)[3],
+                     double dt)
+{
+    if (n > LUB_BODY_MAX_BODIES || np > LUB_BODY_MAX_PAIRS)
+        lub_bug("lub_bodies_step: %d bodies, %d pairs (at most %d, %d)", n, np, LUB_BODY_MAX_BODIES,
+                LUB_BODY_MAX_PAIRS);
+    lub_body_state k[4][LUB_BODY_MAX_BODIES], y[LUB_BODY_MAX_BODIES];
+    double kx[4][LUB_BODY_MAX_PAIRS][3], yx[LUB_BODY_MAX_PAIRS][3];
+    static const double h[4] = {0.0, 0.5, 0.5, 1.0};
+    for (int stage = 0; stage < 4; stage++) {
+        for (int i = 0; i < n; i++)
+            if (stage == 0)
+                y[i] = s[i];
+            else
+                axpy(&y[i], &s[i], h[stage] * dt, &k[stage - 1][i]);
+        for (int q = 0; q < np; q++)
+            for (int d = 0; d < 3; d++)
+                yx[q][d] = xi[q][d] + (stage ? h[stage] * dt * kx[stage - 1][q][d] : 0.0);
+        derivatives(n, b, y, F, T, np, p, (const double(*)[3])yx, k[stage], kx[stage]);
+    }
+    for (int i = 0; i < n; i++) {
+        double *ps = (double *)&s[i];
+        const double *p1 = (double *)&k[0][i], *p2 = (double *)&k[1][i], *p3 = (double *)&k[2][i],
+                     *p4 = (double *)&k[3][i];
+        for (size_t j = 0; j < sizeof s[i] / sizeof(double); j++)
+            ps[j] += dt / 6.0 * (p1[j] + 2.0 * p2[j] + 2.0 * p3[j] + p4[j]);
+    }
+    for (int q = 0; q < np; q++)
+        for (int d = 0; d < 3; d++)
+            xi[q][d] +=
+                dt / 6.0 * (kx[0][q][d] + 2.0 * kx[1][q][d] + 2.0 * kx[2][q][d] + kx[3][q][d]);
+    for (int i = 0; i < n; i++) finish(&b[i], &s[i]);
+    for (int q = 0; q < np; q++) finish_pair(&p[q], b, s, xi[q]);
+}
+
+void lub_body_step(const lub_body *b, lub_body_state *s, const double F[3], const double T[3],
+                   double dt)
+{
+    lub_bodies_step(1, b, s, (const double(*)[3])F, (const double(*)[3])T, 0, NULL, NULL, dt);
 }

@@ -40,11 +40,26 @@
  * c_n = 2 zeta sqrt(k_n M), c_t = 2 zeta sqrt(k_t m_t), m_t = 1 / (1/M + R^2/I) the mass a
  * tangential force at the contact point accelerates.  The tangential spring makes a rolling
  * body stick (rolling without slip, the acceleration (2/3) g sin(slope) of a solid cylinder)
- * instead of creeping as a purely viscous friction would. */
+ * instead of creeping as a purely viscous friction would.
+ *
+ * Contact between two bodies a and b (circles or spheres, lub_body_pair): the same law with
+ * n = (x_b - x_a)/|x_b - x_a|, delta = R_a + R_b + d_c - |x_b - x_a|, the contact points
+ * x_a + R_a n and x_b - R_b n, v the relative velocity of b's point against a's; b gets
+ * F_n n + F_t, a the opposite (so the pair conserves momentum, and angular momentum about
+ * any point when F_t = 0); the damping from the pair's masses: c_n = 2 zeta sqrt(k_n m_n),
+ * m_n = 1/(1/M_a + 1/M_b), c_t = 2 zeta sqrt(k_t m_t), 1/m_t = 1/M_a + R_a^2/I_a + 1/M_b +
+ * R_b^2/I_b (a body held in every direction counts as infinitely heavy).  With F_n cut off
+ * at zero (no adhesion), a head-on impact ends when k_n delta + c_n d(delta)/dt = 0, at
+ * w_d t = pi - atan(2 zeta sqrt(1 - zeta^2)/(1 - 2 zeta^2)) (zeta < 1/sqrt 2), and the
+ * coefficient of restitution is e = exp(-zeta w_n t) (zeta/sqrt(1 - zeta^2) sin(w_d t) -
+ * cos(w_d t)) (w_n^2 = k_n/m_n, w_d = w_n sqrt(1 - zeta^2); Schwager and Poeschel, Granular
+ * Matter 9 (2007) 465, on the cut-off). */
 #ifndef LUB_MODELS_RIGIDBODIES_BODY_H
 #define LUB_MODELS_RIGIDBODIES_BODY_H
 
 #define LUB_BODY_MAX_PLANES 8
+#define LUB_BODY_MAX_BODIES 8 /* in one lub_bodies_step */
+#define LUB_BODY_MAX_PAIRS  28
 
 typedef struct {
     double point[3], normal[3]; /* a plane: a point of it and its unit normal into the fluid */
@@ -74,6 +89,13 @@ typedef struct {
     double omega[3]; /* angular velocity, body frame (2-D: [2], the same in both frames) */
     double xi[LUB_BODY_MAX_PLANES][3]; /* tangential springs of the contacts */
 } lub_body_state;
+
+/* A contact between bodies a and b (indices into the set lub_bodies_step integrates). */
+typedef struct {
+    int a, b;
+    double distance; /* d_c [m] */
+    double kn, kt, cn, ct, mu;
+} lub_body_pair;
 
 /* What the body felt at a state (apart from the fluid): contact force and torque. */
 typedef struct {
@@ -111,5 +133,23 @@ void lub_body_contact(const lub_body *b, const lub_body_state *s, lub_body_conta
  * frozen, then q renormalised and the tangential springs of the contacts updated. */
 void lub_body_step(const lub_body *b, lub_body_state *s, const double F[3], const double T[3],
                    double dt);
+
+/* The pair's damping coefficients from the ratio zeta, and the largest dt that resolves its
+ * normal and tangential periods 2 pi sqrt(m_n/k_n), 2 pi sqrt(m_t/k_t) with `steps` steps. */
+void lub_body_pair_damping(lub_body_pair *p, const lub_body *b, double zeta);
+double lub_body_pair_dt_limit(const lub_body_pair *p, const lub_body *b, double steps);
+
+/* The force f on body p->b (body p->a gets -f) and the torques ta, tb on both at states s;
+ * the overlap in *delta; 1 while touching. */
+int lub_body_pair_contact(const lub_body_pair *p, const lub_body *b, const lub_body_state *s,
+                          const double xi[3], double f[3], double ta[3], double tb[3],
+                          double *delta);
+
+/* One step of n bodies b[0..n-1] together (RK4 over all their states and the pairs'
+ * tangential springs xi[0..npairs-1], the pair forces evaluated at every stage), each with its
+ * fluid force F[k] and torque T[k] frozen; as lub_body_step for each body. */
+void lub_bodies_step(int n, const lub_body *b, lub_body_state *s, const double (*F)[3],
+                     const double (*T)[3], int npairs, const lub_body_pair *p, double (*xi)[3],
+                     double dt);
 
 #endif

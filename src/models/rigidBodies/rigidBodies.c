@@ -12,7 +12,9 @@
  *         load:     { force: [0, -10], torque: 0 }              # applied [N/m, N in 2-D]
  *         spring:   { stiffness: 1e3, damping: 0, anchor: [0, 0] }
  *         contact:  { walls: [plate], stiffness: 1e6, friction: 0.3,
- *                     tangentialStiffness: 2.9e5, dampingRatio: 0.3, distance: 0 }
+ *                     tangentialStiffness: 2.9e5, dampingRatio: 0.3, distance: 0,
+ *                     bodies: [ball2] }      # other bodies (circles, spheres) it touches,
+ *                                            #   with these parameters; walls: optional then
  *
  * The body (models/rigidBodies/body.h: its equations, constraints and contact) has the mass,
  * centre and inertia of the wall's shape, not of its particles: a particle sum misses
@@ -65,7 +67,7 @@
 #include "models/model.h"
 #include "models/rigidBodies/body.h"
 
-#define MAX_BODIES      8
+#define MAX_BODIES      LUB_BODY_MAX_BODIES
 #define STEPS_PER_CYCLE 20.0 /* time steps per period of the contact (RK4: 1e-4 per period) */
 
 static const char *const offset_field[3] = {"rigidX0", "rigidY0", "rigidZ0"};
@@ -91,6 +93,11 @@ typedef struct {
 typedef struct {
     int n;
     rigid_body body[MAX_BODIES];
+    int npairs; /* contacts between bodies: pair[k].a lists pair[k].b in its contact */
+    lub_body_pair pair[LUB_BODY_MAX_PAIRS];
+    double xi[LUB_BODY_MAX_PAIRS][3]; /* their tangential springs */
+    lub_node *pair_node[LUB_BODY_MAX_PAIRS];
+    double zeta[MAX_BODIES]; /* each body's contact damping ratio */
     lub_mps *level;
     double *area[3], *f[3]; /* work arrays (P->cap), allocated once */
     int checked;            /* the contact's period checked against dt */
@@ -138,14 +145,16 @@ static void pick_wall(rigid_body *rb, lub_node *patch_node, const lub_geometry *
     }
 }
 
-static void read_contact(rigid_body *rb, lub_node *e, const lub_geometry *g, int dim)
+static void read_contact(rigid_body *rb, lub_node *e, const lub_geometry *g, int dim, double *zeta)
 {
     lub_body *b = &rb->b;
     rb->contact_node = e;
     lub_node_expect_map(e);
-    lub_node *walls = lub_dict_seq(e, "walls");
-    size_t nw = lub_node_size(walls);
-    if (nw == 0 || nw > LUB_BODY_MAX_PLANES)
+    /* plane walls, or other bodies (read_pairs), or both */
+    lub_node *walls =
+        lub_dict_has(e, "bodies") ? lub_dict_seq_or(e, "walls") : lub_dict_seq(e, "walls");
+    size_t nw = walls ? lub_node_size(walls) : 0;
+    if ((walls && nw == 0) || nw > LUB_BODY_MAX_PLANES)
         lub_node_error(walls, "rigidBodies: contact walls: 1 to %d plane walls, found %zu",
                        LUB_BODY_MAX_PLANES, nw);
     if (rb->shape == SHAPE_POLYGON)
@@ -169,10 +178,50 @@ static void read_contact(rigid_body *rb, lub_node *e, const lub_geometry *g, int
     b->kt = lub_dict_real_or(e, "tangentialStiffness", 2.0 / 7.0 * b->kn, LUB_NONNEGATIVE);
     b->mu = lub_dict_real(e, "friction", LUB_NONNEGATIVE);
     b->distance = lub_dict_real_or(e, "distance", 0.0, LUB_NONNEGATIVE);
-    lub_body_contact_damping(b, lub_dict_real_or(e, "dampingRatio", 0.3, LUB_NONNEGATIVE));
+    *zeta = lub_dict_real_or(e, "dampingRatio", 0.3, LUB_NONNEGATIVE);
+    lub_body_contact_damping(b, *zeta);
 }
 
-static void read_body(rigid_body *rb, const char *name, lub_node *e, lub_scene *s)
+/* The contacts between bodies: each body's `contact: { bodies: [...] }`, with its parameters
+ * (read after every body, for the names and the masses). */
+static void read_pairs(rigid *r)
+{
+    for (int k = 0; k < r->n; k++) {
+        rigid_body *rb = &r->body[k];
+        lub_node *list = rb->contact_node ? lub_dict_seq_or(rb->contact_node, "bodies") : NULL;
+        for (size_t i = 0; list && i < lub_node_size(list); i++) {
+            lub_node *it = lub_node_item(list, i);
+            const char *name = lub_node_text(it);
+            int o = -1;
+            for (int j = 0; j < r->n; j++)
+                if (!strcmp(r->body[j].name, name)) o = j;
+            if (o < 0 || o == k)
+                lub_node_error(it, "rigidBodies: body '%s': contact with '%s': %s", rb->name, name,
+                               o < 0 ? "no such body" : "itself");
+            if (r->body[o].shape != SHAPE_CIRCLE && r->body[o].shape != SHAPE_SPHERE)
+                lub_node_error(it,
+                               "rigidBodies: body '%s': contact with '%s': only between circles "
+                               "or spheres",
+                               rb->name, name);
+            for (int q = 0; q < r->npairs; q++)
+                if ((r->pair[q].a == k && r->pair[q].b == o) ||
+                    (r->pair[q].a == o && r->pair[q].b == k))
+                    lub_node_error(it,
+                                   "rigidBodies: the contact of '%s' and '%s' is listed twice "
+                                   "(once is enough: it acts on both)",
+                                   rb->name, name);
+            if (r->npairs == LUB_BODY_MAX_PAIRS)
+                lub_node_error(it, "rigidBodies: at most %d contacts between bodies",
+                               LUB_BODY_MAX_PAIRS);
+            lub_body_pair *p = &r->pair[r->npairs];
+            p->a = k, p->b = o;
+            p->kn = rb->b.kn, p->kt = rb->b.kt, p->mu = rb->b.mu, p->distance = rb->b.distance;
+            r->pair_node[r->npairs++] = it;
+        }
+    }
+}
+
+static void read_body(rigid_body *rb, const char *name, lub_node *e, lub_scene *s, double *zeta)
 {
     const int dim = s->P->dim;
     lub_node_expect_map(e);
@@ -221,7 +270,7 @@ static void read_body(rigid_body *rb, const char *name, lub_node *e, lub_scene *
         lub_dict_vec_or(spring, "anchor", rb->b.anchor, dim, dim, LUB_ANY);
     }
     lub_node *contact = lub_dict_map_or(e, "contact");
-    if (contact) read_contact(rb, contact, s->geo, dim);
+    if (contact) read_contact(rb, contact, s->geo, dim, zeta);
     if (rb->shape == SHAPE_HOUSING && !(rb->b.hold[0] && rb->b.hold[1] && rb->b.hold[3]))
         lub_node_error(pn,
                        "rigidBodies: wall '%s' holds the fluid inside (a housing): it can only "
@@ -240,13 +289,20 @@ static void rigid_read(lub_model *m, lub_scene *s)
         lub_node_error(m->entry, "rigidBodies: needs the geometry (system/particleGenDict.yaml)");
     r->n = (int)n;
     for (size_t k = 0; k < n; k++) {
-        read_body(&r->body[k], lub_node_key_at(m->entry, k), lub_node_value_at(m->entry, k), s);
+        read_body(&r->body[k], lub_node_key_at(m->entry, k), lub_node_value_at(m->entry, k), s,
+                  &r->zeta[k]);
         for (size_t j = 0; j < k; j++)
             if (r->body[j].patch == r->body[k].patch)
                 lub_node_error(lub_node_value_at(m->entry, k),
                                "rigidBodies: patch '%s' belongs to body '%s' already",
                                s->P->patch_names[r->body[k].patch], r->body[j].name);
     }
+    read_pairs(r);
+    /* the pairs' damping from the masses of both (every body read) */
+    lub_body b[MAX_BODIES];
+    for (int k = 0; k < r->n; k++) b[k] = r->body[k].b;
+    for (int q = 0; q < r->npairs; q++)
+        lub_body_pair_damping(&r->pair[q], b, r->zeta[r->pair[q].a]);
 }
 
 static void rigid_check(lub_model *m, lub_scene *s)
@@ -353,6 +409,22 @@ static void rigid_init(lub_model *m, lub_scene *s)
                 for (int d = 0; d < 3; d++)
                     rb->s.xi[p][d] = lub_node_real(lub_node_item(it, (size_t)d), LUB_ANY);
             }
+            lub_node *xb = lub_dict_seq_or(bs, "xiBodies");
+            size_t nb = xb ? lub_node_size(xb) : 0, got = 0;
+            for (int q = 0; q < r->npairs; q++) {
+                if (r->pair[q].a != k) continue;
+                if (got >= nb)
+                    lub_fatal("%s: rigidBodies: body '%s': too few xiBodies for its contacts",
+                              s->state_path, rb->name);
+                lub_node *it = lub_node_item(xb, got++);
+                if (lub_node_size(it) != 3)
+                    lub_node_error(it, "rigidBodies: xiBodies: expected 3 numbers");
+                for (int d = 0; d < 3; d++)
+                    r->xi[q][d] = lub_node_real(lub_node_item(it, (size_t)d), LUB_ANY);
+            }
+            if (got != nb)
+                lub_fatal("%s: rigidBodies: body '%s': %zu xiBodies, expected %zu", s->state_path,
+                          rb->name, nb, got);
         }
     }
 }
@@ -404,12 +476,39 @@ static lub_step_status rigid_before_step(lub_model *m, lub_scene *s, double t, d
                                b->kn * (lim / dt) * (lim / dt), b->kt * (lim / dt) * (lim / dt),
                                STEPS_PER_CYCLE, lim);
         }
+        lub_body b[MAX_BODIES];
+        for (int k = 0; k < r->n; k++) b[k] = r->body[k].b;
+        for (int q = 0; q < r->npairs; q++) {
+            const lub_body_pair *p = &r->pair[q];
+            const double lim = lub_body_pair_dt_limit(p, b, STEPS_PER_CYCLE);
+            if (dt > lim)
+                lub_node_error(r->pair_node[q],
+                               "rigidBodies: the contact of '%s' and '%s': its period (normal 2 "
+                               "pi sqrt(m/k), m = 1/(1/M_a + 1/M_b), or tangential) is %g s, "
+                               "resolved by dt = %g s only with stiffness <= %g "
+                               "(tangentialStiffness <= %g): %g steps per period needed, or "
+                               "deltaT <= %g s",
+                               r->body[p->a].name, r->body[p->b].name, lim * STEPS_PER_CYCLE, dt,
+                               p->kn * (lim / dt) * (lim / dt), p->kt * (lim / dt) * (lim / dt),
+                               STEPS_PER_CYCLE, lim);
+        }
     }
+    /* all bodies together: the contacts between them act at every Runge-Kutta stage */
+    lub_body b[MAX_BODIES];
+    lub_body_state st[MAX_BODIES];
+    double F[MAX_BODIES][3], T[MAX_BODIES][3];
+    for (int k = 0; k < r->n; k++) {
+        b[k] = r->body[k].b, st[k] = r->body[k].s;
+        memcpy(F[k], r->body[k].F, sizeof F[k]);
+        memcpy(T[k], r->body[k].T, sizeof T[k]);
+    }
+    lub_bodies_step(r->n, b, st, (const double(*)[3])F, (const double(*)[3])T, r->npairs, r->pair,
+                    r->xi, dt);
     double *x0[3];
     fields(P, x0);
     for (int k = 0; k < r->n; k++) {
         rigid_body *rb = &r->body[k];
-        lub_body_step(&rb->b, &rb->s, rb->F, rb->T, dt);
+        rb->s = st[k];
         double R[3][3];
         lub_body_rotation(&rb->b, &rb->s, R);
         for (size_t i = 0; i < P->n; i++) {
@@ -508,12 +607,40 @@ static void rigid_header(const lub_model *m, const lub_scene *s)
                         rb->name, b->nplanes, b->kn, b->kt, b->cn, b->ct, b->mu, b->distance,
                         lub_body_dt_limit(b, STEPS_PER_CYCLE), STEPS_PER_CYCLE);
     }
+    lub_body b[MAX_BODIES];
+    for (int k = 0; k < r->n; k++) b[k] = r->body[k].b;
+    for (int q = 0; q < r->npairs; q++) {
+        const lub_body_pair *p = &r->pair[q];
+        lub_message("rigidBodies: contact of %s and %s: k_n %g, k_t %g, c_n %g, c_t %g, friction "
+                    "%g, distance %g m; dt <= %g s (%g steps per period)",
+                    r->body[p->a].name, r->body[p->b].name, p->kn, p->kt, p->cn, p->ct, p->mu,
+                    p->distance, lub_body_pair_dt_limit(p, b, STEPS_PER_CYCLE), STEPS_PER_CYCLE);
+    }
 }
 
-static void row(const rigid_body *rb, int dim, double t, FILE *fp)
+/* the contact force and torque on body k: its planes' and the other bodies' */
+static void contact_sum(const rigid *r, int k, lub_body_contact_sum *c)
 {
+    lub_body_contact(&r->body[k].b, &r->body[k].s, c);
+    lub_body b[MAX_BODIES];
+    lub_body_state st[MAX_BODIES];
+    for (int j = 0; j < r->n; j++) b[j] = r->body[j].b, st[j] = r->body[j].s;
+    for (int q = 0; q < r->npairs; q++) {
+        const lub_body_pair *p = &r->pair[q];
+        double f[3], ta[3], tb[3], del;
+        if ((p->a != k && p->b != k) || !lub_body_pair_contact(p, b, st, r->xi[q], f, ta, tb, &del))
+            continue;
+        c->ncontacts++;
+        for (int d = 0; d < 3; d++)
+            c->F[d] += p->b == k ? f[d] : -f[d], c->T[d] += p->b == k ? tb[d] : ta[d];
+    }
+}
+
+static void row(const rigid *r, int k, int dim, double t, FILE *fp)
+{
+    const rigid_body *rb = &r->body[k];
     lub_body_contact_sum c;
-    lub_body_contact(&rb->b, &rb->s, &c);
+    contact_sum(r, k, &c);
     double v[32];
     size_t n = 0;
     v[n++] = t;
@@ -557,7 +684,7 @@ static void rigid_functions_start(lub_model *m, lub_scene *s, const char *start,
                 rb->table, "t[s] x[m] y[m] z[m] qw qx qy qz Vx[m/s] Vy[m/s] Vz[m/s] "
                            "omegax[rad/s] omegay[rad/s] omegaz[rad/s] Fx[N] Fy[N] Fz[N] Tx[N*m] "
                            "Ty[N*m] Tz[N*m] Fcx[N] Fcy[N] Fcz[N] Tcx[N*m] Tcy[N*m] Tcz[N*m]");
-        row(rb, dim, t, rb->table);
+        row(r, k, dim, t, rb->table);
     }
 }
 
@@ -567,7 +694,7 @@ static void rigid_functions_execute(lub_model *m, lub_scene *s, double t, long s
     rigid *r = m->state;
     for (int k = 0; k < r->n; k++) {
         if (!r->body[k].table) continue;
-        row(&r->body[k], s->P->dim, t, r->body[k].table);
+        row(r, k, s->P->dim, t, r->body[k].table);
         fflush(r->body[k].table);
     }
 }
@@ -616,6 +743,16 @@ static void rigid_write_state(const lub_model *m, const lub_scene *s, FILE *fp)
             put_vec(fp, "q", rb->s.q, 4, "orientation (w, x, y, z)");
             put_vec(fp, "omega", rb->s.omega, 3, "angular velocity, body frame [rad/s]");
             put_vec(fp, "T", rb->T, 3, "the fluid's torque of the last step [N m]");
+        }
+        int listed = 0;
+        for (int q = 0; q < r->npairs; q++) listed += r->pair[q].a == k;
+        if (listed) {
+            fprintf(fp,
+                    "    xiBodies:   # the tangential springs of its contacts with bodies [m]\n");
+            for (int q = 0; q < r->npairs; q++)
+                if (r->pair[q].a == k)
+                    fprintf(fp, "      - [%.17g, %.17g, %.17g]\n", r->xi[q][0], r->xi[q][1],
+                            r->xi[q][2]);
         }
         if (rb->b.nplanes) {
             fprintf(fp, "    xi:   # the contacts' tangential springs [m]\n");
