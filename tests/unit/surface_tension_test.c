@@ -211,7 +211,7 @@ static void test_laplace_mps(void)
 }
 
 /* The mode-2 oscillation of a free 2-D drop (no walls, no gravity) against Rayleigh's
- * omega^2 = n (n^2 - 1) sigma / (rho R^3), n = 2 (methods2.md §8): the lattice disc of radius
+ * omega^2 = n (n^2 - 1) sigma / (rho R^3), n = 2 (Rayleigh 1879): the lattice disc of radius
  * 10 l0 (R = 9.85 l0 from its area) settles for 0.03 s (nu 1e-4 m^2/s, lambda 1 Pa s: three
  * viscous times R^2/nu), then is set moving with the potential flow of the mode at its
  * equilibrium crossing, u = eps omega (x, -y) about the centroid, eps = 0.05, with nu =
@@ -279,7 +279,7 @@ static void test_oscillation_2d(void)
 /* A 2-D sessile drop (16 x 8 particles set on a plane wall, no gravity; methods.md §9): the
  * contact angle it reaches with contactAngle: theta, through the model's table, against
  * theta within 5 degrees.  The angle of the circular cap through the drop's height h above
- * the wall's surface and its half-base a, tan(theta/2) = h/a (methods2.md §8), h the top
+ * the wall's surface and its half-base a, tan(theta/2) = h/a, h the top
  * particle's height above the wall layer, a the first row's half-width plus l0/2, as
  * tests/bench/sessile_bench.c measured the table.  One spacing of h or a is 3-5 degrees
  * here. */
