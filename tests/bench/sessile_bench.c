@@ -12,7 +12,10 @@
  *
  *     build/bench/sessile_bench [c ...]          (default: c = (1 + cos theta)/2 for theta
  *                                                 = 30, 60, 90, 120 degrees)
+ *     build/bench/sessile_bench -angle 30 60 ... through contactAngle (the model's table)
  *     LUB_STEPS=N build/bench/sessile_bench ...  N steps of 2e-5 s instead of 5000
+ *     LUB_SCALE=s build/bench/sessile_bench ...  a drop of 16 s x 8 s particles
+ * The angle is printed every 2500 steps (0.05 s).
  */
 #include <math.h>
 #include <stdio.h>
@@ -46,16 +49,21 @@ static int hook(void *ctx, const lub_mps *m, double *const acc[3])
     return d->model.type->particle_forces(&d->model, m, acc);
 }
 
-static double angle_for(double c)
+static double angle_for(double c, double want)
 {
-    const char *geo = "dimension: 2\n"
-                      "l0: 1.0e-4\n"
-                      "domain: { min: [-0.005, -0.0006], max: [0.005, 0.003] }\n"
-                      "dummyLayers: 3\n"
-                      "walls:\n"
-                      "  wall: { type: plane, point: [0, 0], normal: [0, 1] }\n"
-                      "fluid:\n"
-                      "  - { type: box, min: [-0.0008, 0], max: [0.0008, 0.0008] }\n";
+    /* LUB_SCALE = s: a drop of 16 s x 8 s particles (the resolution study) */
+    const double sc = getenv("LUB_SCALE") ? atof(getenv("LUB_SCALE")) : 1.0;
+    char geo[1024];
+    snprintf(geo, sizeof geo,
+             "dimension: 2\n"
+             "l0: 1.0e-4\n"
+             "domain: { min: [%g, -0.0006], max: [%g, %g] }\n"
+             "dummyLayers: 3\n"
+             "walls:\n"
+             "  wall: { type: plane, point: [0, 0], normal: [0, 1] }\n"
+             "fluid:\n"
+             "  - { type: box, min: [%g, 0], max: [%g, %g] }\n",
+             -0.005 * sc, 0.005 * sc, 0.003 * sc, -0.0008 * sc, 0.0008 * sc, 0.0008 * sc);
     char path[] = "/tmp/sessileXXXXXX";
     int fd = mkstemp(path);
     if (fd < 0 || write(fd, geo, strlen(geo)) != (ssize_t)strlen(geo)) abort();
@@ -68,8 +76,12 @@ static double angle_for(double c)
     /* the Young-Dupre angle of c, (1 + cos theta)/2 = c, for comparison */
     const double theta = acos(fmax(-1.0, fmin(1.0, 2 * c - 1))) * 180 / M_PI;
     char text[256];
-    snprintf(text, sizeof text, "surfaceTension: { sigma: 0.03, wallFactor: { wall: %.12g } }\n",
-             c);
+    if (want > 0) /* the model's own mapping of the angle */
+        snprintf(text, sizeof text,
+                 "surfaceTension: { sigma: 0.03, contactAngle: { wall: %.12g } }\n", want);
+    else
+        snprintf(text, sizeof text,
+                 "surfaceTension: { sigma: 0.03, wallFactor: { wall: %.12g } }\n", c);
     lub_mps_config cf;
     lub_mps_config_defaults(&cf);
     cf.rho = 1000, cf.nu = 1e-4, cf.bulk_viscosity = 1.0, cf.bulk_modulus = 3e3;
@@ -96,21 +108,30 @@ static double angle_for(double c)
     long bad;
     const char *ns = getenv("LUB_STEPS");
     const int nsteps = ns ? atoi(ns) : 5000;
-    for (int k = 0; k < nsteps; k++)
+    double meas = NAN;
+    for (int k = 1; k <= nsteps; k++) {
         if (lub_mph_step(&m, dt, &bad, msg, sizeof msg) != LUB_STEP_OK) {
             printf("c %.4f: step %d failed: %s\n", c, k, msg);
             return NAN;
         }
-    double top = -INFINITY, xl = INFINITY, xr = -INFINITY;
-    for (size_t i = 0; i < P.n; i++) {
-        if (P.kind[i] != LUB_FLUID) continue;
-        top = fmax(top, P.x[1][i]);
-        if (P.x[1][i] < 1.5 * l0) xl = fmin(xl, P.x[0][i]), xr = fmax(xr, P.x[0][i]);
+        if (k % 2500 && k != nsteps) continue;
+        double top = -INFINITY, xl = INFINITY, xr = -INFINITY;
+        for (size_t i = 0; i < P.n; i++) {
+            if (P.kind[i] != LUB_FLUID) continue;
+            top = fmax(top, P.x[1][i]);
+            if (P.x[1][i] < 1.5 * l0) xl = fmin(xl, P.x[0][i]), xr = fmax(xr, P.x[0][i]);
+        }
+        const double h = top, a = 0.5 * (xr - xl) + 0.5 * l0;
+        meas = 2 * atan(h / a) * 180 / M_PI;
+        if (want > 0)
+            printf("contactAngle %g, t %.2f s: h %.2f l0, a %.2f l0, contact angle %.1f deg\n",
+                   want, k * dt, h / l0, a / l0, meas);
+        else
+            printf("c %.4f (Young-Dupre angle %5.1f deg), t %.2f s: h %.2f l0, a %.2f l0, contact "
+                   "angle %.1f deg\n",
+                   c, theta, k * dt, h / l0, a / l0, meas);
+        fflush(stdout);
     }
-    const double h = top, a = 0.5 * (xr - xl) + 0.5 * l0;
-    const double meas = 2 * atan(h / a) * 180 / M_PI;
-    printf("c %.4f (Young-Dupre angle %5.1f deg): h %.2f l0, a %.2f l0, contact angle %.1f deg\n",
-           c, theta, h / l0, a / l0, meas);
     fflush(stdout);
     lub_mps_free(&m);
     d.model.type->free(&d.model);
@@ -124,10 +145,13 @@ static double angle_for(double c)
 int main(int argc, char **argv)
 {
     if (argc > 1) {
-        for (int k = 1; k < argc; k++) angle_for(atof(argv[k]));
+        if (strcmp(argv[1], "-angle") == 0)
+            for (int k = 2; k < argc; k++) angle_for(NAN, atof(argv[k]));
+        else
+            for (int k = 1; k < argc; k++) angle_for(atof(argv[k]), 0);
         return 0;
     }
     const double th[] = {30, 60, 90, 120};
-    for (int k = 0; k < 4; k++) angle_for(0.5 * (1 + cos(th[k] * M_PI / 180)));
+    for (int k = 0; k < 4; k++) angle_for(0.5 * (1 + cos(th[k] * M_PI / 180)), 0);
     return 0;
 }

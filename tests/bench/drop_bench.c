@@ -1,0 +1,424 @@
+/* Free drops with the two-potential surface tension and the MPH fluid
+ * (src/models/surfaceTension/, doc/methods.md §9), measured for the tables of methods.md §9
+ * (not part of make test):
+ *
+ *     build/bench/drop_bench laplace DIM R0     a drop of the lattice points within R0 l0,
+ *                                               relaxing; its inside pressure read as P and
+ *                                               as the force across two cuts (mechanical),
+ *                                               against sigma / R (2-D), 2 sigma / R (3-D)
+ *     build/bench/drop_bench oscillate DIM R0   the drop set moving in mode 2; the period of
+ *                                               <x^2> - <y^2> against Rayleigh's, the decay
+ *                                               rate against Lamb's
+ *     build/bench/drop_bench slab DIM T         a slab T l0 thick, periodic across (LUB_WIDTH
+ *                                               l0, 20): its tension (the force across a
+ *                                               normal cut) and energy per area
+ *
+ * l0 = 0.1 mm, rho 1000; environment: LUB_STEPS (steps of LUB_DT, 2e-5 s), LUB_NU (1e-4),
+ * LUB_KAPPA (3e3), LUB_LAMBDA (1), LUB_SIGMA (0.03), LUB_AMP (the mode-2 amplitude eps, 0.1),
+ * LUB_RELAX (steps with nu 1e-4, lambda 1 before the mode is set moving), LUB_EVERY (steps
+ * between printed lines, 100).  The pair sums of the mechanical pressure are over all pairs:
+ * slow beyond a few thousand particles.
+ */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "core/error.h"
+#include "io/dict.h"
+#include "models/fluid/mph.h"
+#include "models/model.h"
+#include "mps/mps.h"
+
+#ifndef M_PI
+#define M_PI 3.14159265358979323846
+#endif
+
+extern const lub_model_type lub_model_surfaceTension;
+extern const lub_fluid_type lub_fluid_mph;
+
+typedef struct {
+    lub_model model;
+    lub_scene scene;
+    lub_dict *dict;
+} driver;
+
+static int hook(void *ctx, const lub_mps *m, double *const acc[3])
+{
+    driver *d = ctx;
+    return d->model.type->particle_forces(&d->model, m, acc);
+}
+
+/* ---- the mechanical stress across a cut, from the pair forces ------------------------------
+ * The model's forces are sums of antisymmetric pair terms (methods.md §9, (K-8)) and the
+ * fluid's pressure term too ((K-6): dV (P_i + P_j) e_ij w_p'), so the force that the particles
+ * on one side of a plane exert on those of the other side is the sum over the pairs whose
+ * segment crosses the plane (Irving-Kirkwood).  Formed here over all pairs (no walls; x
+ * periodic with period Lx if Lx > 0), at rest (the viscous terms left out). */
+static double k_wa(int dim, double l0, double h, double r)
+{
+    if (!(r < h)) return 0.0;
+    const double q = r / h, lh = l0 / h;
+    return q * (1 - q) * (1 - q) * (dim == 2 ? lh * lh : lh * lh * lh) * 15.0 / M_PI;
+}
+static double k_dwa(int dim, double l0, double h, double r)
+{
+    if (!(r < h)) return 0.0;
+    const double q = r / h, lh = l0 / h;
+    return (1 - q) * (1 - 3 * q) / h * (dim == 2 ? lh * lh : lh * lh * lh) * 15.0 / M_PI;
+}
+
+typedef struct {
+    double a, k, ch, n0a, hs, l0;
+    int dim;
+    double Lx;
+} stmodel;
+
+static void st_setup(stmodel *M, int dim, double l0, double sigma, double Lx)
+{
+    M->dim = dim, M->l0 = l0, M->hs = 3.5 * l0, M->Lx = Lx;
+    M->k = dim == 2 ? 0.350778153 : 0.326976006;
+    const double IN = dim == 2 ? 0.024679383 : 0.021425779;
+    const double IX = dim == 2 ? 0.226126699 : 0.233977488;
+    M->a = sigma / (M->hs * (IN + M->k * M->k * IX));
+    const double R2 = dim == 2 ? M->hs * M->hs / 10.0 : 2.0 * M->hs * M->hs / 21.0;
+    M->ch = M->hs / R2;
+    M->n0a = 0;
+    const int hz = dim == 3 ? 4 : 0;
+    for (int x = -4; x <= 4; x++)
+        for (int y = -4; y <= 4; y++)
+            for (int z = -hz; z <= hz; z++) {
+                const double r = l0 * sqrt((double)(x * x + y * y + z * z));
+                if (r > 0) M->n0a += k_wa(dim, l0, M->hs, r);
+            }
+}
+
+static double sep(const stmodel *M, const lub_particles *P, size_t i, size_t j, double r[3])
+{
+    double r2 = 0;
+    for (int q = 0; q < 3; q++) {
+        r[q] = q < M->dim ? P->x[q][j] - P->x[q][i] : 0.0;
+        if (q != 1 && M->Lx > 0) r[q] -= M->Lx * round(r[q] / M->Lx);
+        r2 += r[q] * r[q];
+    }
+    return sqrt(r2);
+}
+
+/* The force per length (2-D) or area (3-D) across the plane x[ax] = xc, restricted to the
+ * crossing points within rc of centre (rc <= 0: anywhere), that the side above exerts... on
+ * the side above from below: returned along ax (normal: + pushes apart, a pressure) and
+ * along tg (tangential) in out[0], out[1]; and the same from the P pairs alone in out[2]. */
+static void cut_stress(const stmodel *M, const lub_particles *P, int ax, int tg, double xc,
+                       const double centre[3], double rc, double out[3])
+{
+    const int dim = M->dim;
+    const size_t n = P->n;
+    double *na = lub_calloc(n, sizeof(double)), *chi[3];
+    for (int q = 0; q < 3; q++) chi[q] = lub_calloc(n, sizeof(double));
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = 0; j < n; j++) {
+            double r[3];
+            const double d = sep(M, P, i, j, r);
+            if (j == i || !(d < M->hs)) continue;
+            na[i] += k_wa(dim, M->l0, M->hs, d);
+            const double wg = lub_mph_w(dim, M->l0, M->hs, d);
+            for (int q = 0; q < dim; q++) chi[q][i] += M->ch * r[q] * wg;
+        }
+    for (size_t i = 0; i < n; i++) na[i] = fmin(na[i] - M->n0a, 0.0);
+    const double dA = dim == 2 ? M->l0 * M->l0 : M->l0 * M->l0 * M->l0;
+    const double hp = LUB_MPH_HP * M->l0, ak2 = M->a * M->k * M->k * M->ch;
+    double Fn = 0, Ft = 0, Fp = 0;
+    for (size_t i = 0; i < n; i++) {
+        if (!(P->x[ax][i] < xc)) continue; /* i below, j above */
+        for (size_t j = 0; j < n; j++) {
+            double r[3];
+            const double d = sep(M, P, i, j, r);
+            if (j == i || !(d < M->hs) || !(P->x[ax][i] + r[ax] >= xc)) continue;
+            /* the crossing point */
+            const double t = (xc - P->x[ax][i]) / r[ax];
+            double off2 = 0;
+            for (int q = 0; q < dim; q++)
+                if (q != ax) {
+                    double o = P->x[q][i] + t * r[q] - centre[q];
+                    if (q != 1 && M->Lx > 0) o -= M->Lx * round(o / M->Lx);
+                    off2 += o * o;
+                }
+            if (rc > 0 && off2 > rc * rc) continue;
+            /* the force on j from i: e_ji = -r/d */
+            double e[3], v[3], vr = 0;
+            for (int q = 0; q < 3; q++) {
+                e[q] = -r[q] / d;
+                v[q] = q < dim ? chi[q][i] - chi[q][j] : 0.0;
+                vr += v[q] * -r[q];
+            }
+            const double cpp = M->a * (na[i] + na[j]) * k_dwa(dim, M->l0, M->hs, d);
+            const double pp = d < hp ? (P->p[i] + P->p[j]) * lub_mph_dw(dim, M->l0, hp, d) : 0;
+            const double wg = lub_mph_w(dim, M->l0, M->hs, d);
+            const double dwg = lub_mph_dw(dim, M->l0, M->hs, d);
+            double f[3];
+            for (int q = 0; q < 3; q++)
+                f[q] = dA * ((cpp + pp) * e[q] - ak2 * (wg * v[q] + vr * e[q] * dwg));
+            Fn += f[ax], Ft += f[tg], Fp += dA * pp * e[ax];
+        }
+    }
+    const double area = rc <= 0 ? 1.0 : dim == 2 ? 2 * rc : M_PI * rc * rc;
+    out[0] = Fn / area, out[1] = Ft / area, out[2] = Fp / area;
+    free(na);
+    for (int q = 0; q < 3; q++) free(chi[q]);
+}
+
+/* The surface potential (K-7b) and the elastic energy sum (kappa/2) max(n - n0, 0)^2 dV of
+ * every particle (per unit depth in 2-D), over all pairs. */
+static void energies(const stmodel *M, const lub_particles *P, double kappa, double *Vs, double *Ve)
+{
+    const int dim = M->dim;
+    const double hp = LUB_MPH_HP * M->l0, n0 = lub_mph_n0(dim, M->l0);
+    const double dA = dim == 2 ? M->l0 * M->l0 : M->l0 * M->l0 * M->l0;
+    *Vs = *Ve = 0;
+    for (size_t i = 0; i < P->n; i++) {
+        double na = 0, np = 0, chi[3] = {0, 0, 0};
+        for (size_t j = 0; j < P->n; j++) {
+            double r[3];
+            const double d = sep(M, P, i, j, r);
+            if (j == i || !(d < M->hs)) continue;
+            na += k_wa(dim, M->l0, M->hs, d);
+            np += lub_mph_w(dim, M->l0, hp, d);
+            const double wg = lub_mph_w(dim, M->l0, M->hs, d);
+            for (int q = 0; q < dim; q++) chi[q] += M->ch * r[q] * wg;
+        }
+        const double N = fmin(na - M->n0a, 0.0), e = fmax(np - n0, 0.0);
+        *Vs += 0.5 * M->a *
+               (N * N + M->k * M->k * (chi[0] * chi[0] + chi[1] * chi[1] + chi[2] * chi[2])) * dA;
+        *Ve += 0.5 * kappa * e * e * dA;
+    }
+}
+
+static double env(const char *name, double def)
+{
+    const char *e = getenv(name);
+    return e ? atof(e) : def;
+}
+
+int main(int argc, char **argv)
+{
+    if (argc < 4) {
+        fprintf(stderr, "usage: drop_bench laplace|oscillate DIM R0\n");
+        return 1;
+    }
+    const int osc = strcmp(argv[1], "oscillate") == 0, dim = atoi(argv[2]);
+    const int slab = strcmp(argv[1], "slab") == 0, W = (int)env("LUB_WIDTH", 20);
+    const double R0 = atof(argv[3]);
+    const double l0 = 1e-4, rho = 1000, sigma = env("LUB_SIGMA", 0.03);
+    const double nu = env("LUB_NU", 1e-4), kappa = env("LUB_KAPPA", 3e3);
+    const double lambda = env("LUB_LAMBDA", 1.0), dt = env("LUB_DT", 2e-5);
+    const long nsteps = (long)env("LUB_STEPS", 3000), every = (long)env("LUB_EVERY", 100);
+    const double amp = env("LUB_AMP", 0.1);
+    lub_particles P;
+    lub_particles_init(&P, dim, 1);
+    P.nlevels = 1;
+    P.levels[0].l0 = l0;
+    const int n = (int)ceil(R0), nz = dim == 3 ? n : 0;
+    if (slab) /* x (and z) periodic over W l0, y from 0 to R0 l0 */
+        for (int a = 0; a < W; a++)
+            for (int b = 0; b < (int)R0; b++)
+                for (int c = 0; c < (dim == 3 ? W : 1); c++) {
+                    const double x[3] = {a * l0, b * l0, c * l0};
+                    lub_particles_add(&P, x, LUB_FLUID, 0, 0);
+                }
+    for (int a = -n; a <= n && !slab; a++)
+        for (int b = -n; b <= n; b++)
+            for (int c = -nz; c <= nz; c++)
+                if (a * a + b * b + c * c < R0 * R0) {
+                    const double x[3] = {a * l0, b * l0, c * l0};
+                    lub_particles_add(&P, x, LUB_FLUID, 0, 0);
+                }
+    const double R = dim == 2 ? l0 * sqrt(P.n / M_PI) : l0 * cbrt(3.0 * P.n / (4 * M_PI));
+    lub_mps_config c;
+    lub_mps_config_defaults(&c);
+    c.rho = rho, c.nu = nu, c.bulk_viscosity = lambda, c.bulk_modulus = kappa;
+    c.list_l0 = LUB_MPH_HV, c.predictor = 0, c.clip_negative = LUB_NEGATIVE_KEEP;
+    c.v_solver.kind = LUB_LINSOLVER_PCG;
+    c.v_solver.pcg.precond = LUB_PRECOND_JACOBI;
+    c.v_solver.pcg.tolerance = 1e-10;
+    char text[256];
+    snprintf(text, sizeof text, "surfaceTension: { sigma: %.12g }\n", sigma);
+    driver d;
+    memset(&d, 0, sizeof d);
+    d.dict = lub_dict_parse("constant/models.yaml", text);
+    d.scene.P = &P;
+    d.scene.dict = d.dict;
+    d.scene.fluid = &lub_fluid_mph;
+    d.model.type = &lub_model_surfaceTension;
+    d.model.entry = lub_dict_find(lub_dict_root(d.dict), "surfaceTension");
+    d.model.state = lub_calloc(1, d.model.type->size);
+    d.model.type->read(&d.model, &d.scene);
+    d.model.type->configure(&d.model, &d.scene, &c);
+    const double L = R0 * (osc ? 1.6 : 1) * l0 + 8 * l0;
+    double lo[3] = {-L, -L, -L}, hi[3] = {L, L, L};
+    int periodic[3] = {0, 0, 0};
+    if (slab) {
+        lo[0] = lo[2] = -0.5 * l0, hi[0] = hi[2] = (W - 0.5) * l0;
+        lo[1] = -10 * l0, hi[1] = (R0 + 10) * l0;
+        periodic[0] = 1, periodic[2] = dim == 3;
+    }
+    stmodel M;
+    st_setup(&M, dim, l0, sigma, slab ? W * l0 : 0.0);
+    lub_mps m;
+    lub_mps_init(&m, &P, &c, lo, hi, periodic);
+    d.scene.nlevels = 1, d.scene.level[0] = &m;
+    d.model.type->init(&d.model, &d.scene);
+    m.hooks.ctx = &d, m.hooks.particle_forces = hook;
+    const double dp = (dim == 2 ? 1 : 2) * sigma / R;
+    /* the interior: farther than 2 h_s from the surface (the surface forces reach h_s, through
+     * n^a and chi of neighbours within h_s), or within R/2 if that is larger */
+    const double rin = fmax(R - 2 * 3.5 * l0, 0.5 * R);
+    const double omega2 = (dim == 2 ? 6.0 : 8.0) * sigma / (rho * R * R * R);
+    const double T = 2 * M_PI / sqrt(omega2);
+    /* LUB_RELAX steps first with nu 1e-4, lambda 1 Pa s: the drop settles from the lattice
+     * disc before the mode is set moving (the oscillation about equilibrium) */
+    const long nrelax = (long)env("LUB_RELAX", 0);
+    if (nrelax > 0) {
+        m.c.nu = 1e-4, m.c.bulk_viscosity = 1.0;
+        char rmsg[512];
+        long rbad;
+        for (long k = 0; k < nrelax; k++)
+            if (lub_mph_step(&m, dt, &rbad, rmsg, sizeof rmsg) != LUB_STEP_OK) {
+                printf("relaxation step %ld failed: %s\n", k, rmsg);
+                return 1;
+            }
+        m.c.nu = nu, m.c.bulk_viscosity = lambda;
+    }
+    if (osc) { /* the velocity of mode 2 at its equilibrium crossing: u = eps omega (x, -y) */
+        const double v = amp * sqrt(omega2);
+        double cx[2] = {0, 0};
+        for (size_t i = 0; i < P.n; i++) cx[0] += P.x[0][i] / P.n, cx[1] += P.x[1][i] / P.n;
+        for (size_t i = 0; i < P.n; i++) {
+            P.u[0][i] = v * (P.x[0][i] - cx[0]);
+            P.u[1][i] = -v * (P.x[1][i] - cx[1]);
+        }
+    }
+    printf("%s %d-D: %zu particles, R = %.3f l0 (R0 %.2f), dp %.4g Pa, T %.4g s (%.0f steps); "
+           "kappa %g, lambda %g, nu %g\n",
+           argv[1], dim, P.n, R / l0, R0, dp, T, T / dt, kappa, lambda, nu);
+    const double *pc = lub_particles_find_extra(&P, "pCohesive");
+    char msg[512];
+    long bad;
+    double sum = 0, sumn = 0, summ = 0;
+    if (slab) { /* the tension of the lattice slab as built (P = 0) */
+        double o[3];
+        const double ctr[3] = {0, 0, 0};
+        cut_stress(&M, &P, 0, 1, 0.5 * l0 * (W / 2 - 0.5) + 0.25 * l0 * 0, ctr, 0, o);
+        printf("lattice slab: tension %.5g N/m = %.4f sigma\n", -0.5 * o[0], -0.5 * o[0] / sigma);
+        double Vs, Ve;
+        energies(&M, &P, kappa, &Vs, &Ve);
+        const double area = dim == 2 ? 2 * W * l0 : 2 * W * W * l0 * l0;
+        printf("lattice slab: energy per area %.5g = %.4f sigma (surface %.4f, elastic %.4f)\n",
+               (Vs + Ve) / area, (Vs + Ve) / area / sigma, Vs / area / sigma, Ve / area / sigma);
+    }
+    /* the oscillation: D(t) = <x^2> - <y^2> about the centroid, its zero crossings (linear
+     * interpolation) and its extremes between them */
+    double Dprev = 0, tcross[64], ext[64], dext = 0;
+    int ncross = 0;
+    for (long k = 1; k <= nsteps; k++) {
+        if (lub_mph_step(&m, dt, &bad, msg, sizeof msg) != LUB_STEP_OK) {
+            printf("step %ld failed: %s\n", k, msg);
+            return 1;
+        }
+        if (osc) {
+            double cx[2] = {0, 0}, sx = 0, sy = 0;
+            for (size_t i = 0; i < P.n; i++) cx[0] += P.x[0][i] / P.n, cx[1] += P.x[1][i] / P.n;
+            for (size_t i = 0; i < P.n; i++) {
+                sx += (P.x[0][i] - cx[0]) * (P.x[0][i] - cx[0]) / P.n;
+                sy += (P.x[1][i] - cx[1]) * (P.x[1][i] - cx[1]) / P.n;
+            }
+            const double D = sx - sy;
+            if (fabs(D) > fabs(dext)) dext = D;
+            if (k > 1 && (D > 0) != (Dprev > 0) && ncross < 64) {
+                tcross[ncross] = (k - 1 + Dprev / (Dprev - D)) * dt;
+                ext[ncross++] = fabs(dext);
+                dext = 0;
+            }
+            Dprev = D;
+        }
+        if (k % every) continue;
+        double cx[3] = {0, 0, 0}, ke = 0;
+        for (size_t i = 0; i < P.n; i++)
+            for (int q = 0; q < dim; q++)
+                cx[q] += P.x[q][i] / P.n, ke += 0.5 * P.u[q][i] * P.u[q][i] / P.n;
+        double sp = 0, sc = 0, sx = 0, sy = 0;
+        int cnt = 0;
+        for (size_t i = 0; i < P.n; i++) {
+            double r2 = 0;
+            for (int q = 0; q < dim; q++) r2 += (P.x[q][i] - cx[q]) * (P.x[q][i] - cx[q]);
+            if (r2 < rin * rin) sp += P.p[i], sc += pc[i], cnt++;
+            sx += (P.x[0][i] - cx[0]) * (P.x[0][i] - cx[0]);
+            sy += (P.x[1][i] - cx[1]) * (P.x[1][i] - cx[1]);
+        }
+        if (slab) {
+            double o[3];
+            const double ctr[3] = {0, 0, 0};
+            cut_stress(&M, &P, 0, 1, (W / 2 - 0.5) * l0, ctr, 0, o);
+            double ymin = INFINITY, ymax = -INFINITY;
+            for (size_t i = 0; i < P.n; i++)
+                ymin = fmin(ymin, P.x[1][i]), ymax = fmax(ymax, P.x[1][i]);
+            printf("t %.5f: slab tension %.5g N/m = %.4f sigma (P pairs %.4g); thickness %.3f "
+                   "l0, rms u %.3g\n",
+                   k * dt, -0.5 * o[0], -0.5 * o[0] / sigma, -0.5 * o[2], (ymax - ymin) / l0,
+                   sqrt(2 * ke));
+            if (k > nsteps / 2) sum += -0.5 * o[0] / sigma, sumn++;
+            double Vs, Ve;
+            energies(&M, &P, kappa, &Vs, &Ve);
+            const double area = dim == 2 ? 2 * W * l0 : 2 * W * W * l0 * l0;
+            printf("  energy per area %.4f sigma (surface %.4f, elastic %.4f)\n",
+                   (Vs + Ve) / area / sigma, Vs / area / sigma, Ve / area / sigma);
+            continue;
+        }
+        /* the mechanical pressure: the force across the interior parts of the two cuts
+         * through the centroid (x and y), per length (area) */
+        double o[3], o2[3];
+        cut_stress(&M, &P, 1, 0, cx[1], cx, rin, o);
+        cut_stress(&M, &P, 0, 1, cx[0], cx, rin, o2);
+        const double pm = 0.5 * (o[0] + o2[0]);
+        printf("  cuts through the centre: interior pressure %.5g Pa = %.4f dp (P pairs %.4f "
+               "dp)\n",
+               pm, pm / dp, 0.5 * (o[2] + o2[2]) / dp);
+        if (!osc && k > nsteps / 2) summ += pm;
+        if (!osc && k > nsteps / 2) sum += (sp + sc) / cnt, sumn++;
+        printf("t %.5f: P %.5g pc %.5g sum/dp %.4f  rms u %.3g  <x2>-<y2> %.4g l0^2\n", k * dt,
+               sp / cnt, sc / cnt, (sp + sc) / cnt / dp, sqrt(2 * ke), (sx - sy) / P.n / (l0 * l0));
+        fflush(stdout);
+    }
+    if (osc) {
+        printf("zero crossings:");
+        for (int q = 0; q < ncross; q++) printf(" %.5f", tcross[q]);
+        printf("\n");
+        /* the period from the first to the last crossing of an even count after it */
+        const int last = ncross - 1 - (ncross - 1) % 2;
+        if (last >= 2) {
+            const double Tm = (tcross[last] - tcross[0]) / (last / 2);
+            printf("period %.5g s over %d periods, Rayleigh %.5g s: ratio %.4f\n", Tm, last / 2, T,
+                   Tm / T);
+        }
+        /* decay: the extremes of D between successive crossings, half a period apart */
+        if (ncross >= 4) {
+            const double rate =
+                log(ext[1] / ext[ncross - 1]) /
+                (0.5 * (tcross[ncross - 1] + tcross[ncross - 2]) - 0.5 * (tcross[1] + tcross[0]));
+            printf("amplitude decay rate %.4g 1/s (extremes %.4g ... %.4g l0^2); Lamb %.4g 1/s\n",
+                   rate, ext[1] / (l0 * l0), ext[ncross - 1] / (l0 * l0),
+                   (dim == 2 ? 4.0 : 5.0) * nu / (R * R));
+        }
+    }
+    if (slab)
+        printf("mean tension over the second half: %.4f sigma\n", sum / sumn);
+    else if (!osc)
+        printf(
+            "mean over the second half: P + pCohesive %.4f of dp, the mechanical pressure %.4f\n",
+            sum / sumn / dp, summ / sumn / dp);
+    lub_mps_free(&m);
+    d.model.type->free(&d.model);
+    free(d.model.state);
+    lub_dict_free(d.dict);
+    lub_particles_free(&P);
+    return 0;
+}
