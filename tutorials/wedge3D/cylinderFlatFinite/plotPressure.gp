@@ -31,3 +31,14 @@ plot "postProcessing/reynoldsRef/0/pInfiniteWidth.dat" using ($1*1e3):($2*1e-3) 
          lc rgb "black" title "Reynolds, width W, z = 0", \
      "postProcessing/wallPressure/0/p.dat" using ($1*1e3):($2*1e-3) with points pt 7 ps 0.6 \
          lc rgb "red" title sprintf("MPS, z = 0, mean %g-%g ms", t0 * 1e3, t1 * 1e3)
+
+# across the width at the x of the reference's mid-plane peak (Allrun writes both tables)
+set output "pressureAcross.png"
+set title sprintf("Roller W = %g mm, l_0 = h_0/%.3g: wall pressure across the width at the mid-plane peak's x", W * 1e3, h0 / l0)
+set xlabel "z [mm]"
+set xrange [-W * 500 - 0.05:W * 500 + 0.05]
+set key bottom center
+plot "postProcessing/reynoldsRef/0/pAcross.dat" using ($1*1e3):($2*1e-3) with lines lw 2 \
+         lc rgb "black" title "Reynolds, width W", \
+     "postProcessing/probe/pAcross.dat" using ($1*1e3):($2*1e-3) with linespoints pt 7 ps 0.6 \
+         lc rgb "red" title sprintf("MPS wall rows, %g-%g ms (time folders)", t0 * 1e3, t1 * 1e3)
