@@ -8,6 +8,8 @@ if (strstrt(GPVAL_TERMINALS, "pngcairo") > 0) {
     set terminal png size 900,600
 }
 set output "pressure.png"
+# the mid-plane table: Allrun gives the latest start's (gnuplot -e "pwall='...'")
+if (!exists("pwall")) pwall = "postProcessing/wallPressure/0/p.dat"
 # the case's own values (its dictionaries, read with lubDict; nan where they cannot be read)
 num(file, key) = (_s = system(sprintf("lubDict %s %s 2>/dev/null | awk '{ printf \"%%.17e\", $1 }'", file, key)), _s eq "" ? NaN : real(_s))
 gen = "system/particleGenDict.yaml"
@@ -29,7 +31,7 @@ plot "postProcessing/reynoldsRef/0/pInfiniteWidth.dat" using ($1*1e3):($2*1e-3) 
          lw 1 dt 2 lc rgb "gray40" title "Reynolds, infinitely wide", \
      "postProcessing/reynoldsRef/0/p.dat" using ($1*1e3):($2*1e-3) with lines lw 2 \
          lc rgb "black" title "Reynolds, width W, z = 0", \
-     "postProcessing/wallPressure/0/p.dat" using ($1*1e3):($2*1e-3) with points pt 7 ps 0.6 \
+     pwall using ($1*1e3):($2*1e-3) with points pt 7 ps 0.6 \
          lc rgb "red" title sprintf("MPS, z = 0, mean %g-%g ms", t0 * 1e3, t1 * 1e3)
 
 # across the width at the x of the reference's mid-plane peak (Allrun writes both tables)
