@@ -370,7 +370,80 @@ static int ring_inside(const lub_geometry *g, const double *cen, double r, int d
     return 1;
 }
 
-/* The layers j0..j1 of a cylinder (layer_radius) */
+/* A 3-D cylinder of finite length (a roller with flat ends, geometry.h; fluid outside):
+ * rings of radius R - j l0 (j = 0 .. dummyLayers) at the axial positions t from -length/2 to
+ * +length/2 (the lattice's when the axis is a coordinate axis, t0 + i step; else
+ * round(length / l0) equal steps), and on the end planes t = +-(length/2 - j l0) a square
+ * grid (the lattice of the two other directions for a coordinate axis) inside radius
+ * R - (dummyLayers + 1/2) l0, at least l0/2 from the innermost ring.  A point is a wall
+ * particle where it lies on the surface (the outer ring, and every point of an end plane's
+ * outer layer), a dummy where it lies j l0 deep (the smaller of its radial and axial
+ * depths). */
+static void sample_roller(gen_ctx *c, const lub_wall *w, const double *e1, const double *e2,
+                          double t0, double step, int lattice)
+{
+    const lub_geometry *g = c->g;
+    const int L = g->dummy_layers;
+    const double l0 = g->levels[c->level].l0, half = 0.5 * w->length;
+    long i0, i1;
+    if (lattice) {
+        step = fabs(step); /* {t0 + i step} over all integers i is the same set */
+        i0 = (long)ceil((-half - t0) / step - 1e-6);
+        i1 = (long)floor((half - t0) / step + 1e-6);
+    } else {
+        long n = lround(w->length / l0);
+        step = w->length / (double)(n < 1 ? 1 : n);
+        t0 = -half;
+        i0 = 0;
+        i1 = n < 1 ? 1 : n;
+    }
+    for (long i = i0; i <= i1; i++) {
+        double t = t0 + i * step, cen[3];
+        long e = lround((half - fabs(t)) / l0); /* axial depth in layers */
+        for (int d = 0; d < 3; d++) cen[d] = w->centre[d] + t * w->axis[d];
+        for (int j = 0; j <= L; j++)
+            sample_ring(c, w, cen, e1, e2, layer_radius(w, j, l0),
+                        (e < j ? e : j) ? LUB_DUMMY : LUB_WALL, 1);
+    }
+    /* the flat ends; the grid searched only where the domain is */
+    const double rmax = w->radius - (L + 0.5) * l0;
+    if (!(rmax > 0)) return;
+    for (int side = -1; side <= 1; side += 2)
+        for (int j = 0; j <= L; j++) {
+            double t = side * (half - j * l0), cen[3];
+            for (int d = 0; d < 3; d++) cen[d] = w->centre[d] + t * w->axis[d];
+            double off[2] = {0, 0}, lo[2] = {-rmax, -rmax}, hi[2] = {rmax, rmax};
+            const double *e[2] = {e1, e2};
+            for (int k = 0; k < 2; k++) {
+                double plo = INFINITY, phi = -INFINITY;
+                for (int corner = 0; corner < 8; corner++) {
+                    double q[3];
+                    for (int d = 0; d < 3; d++)
+                        q[d] = ((corner >> d) & 1 ? g->dmax[d] : g->dmin[d]) - cen[d];
+                    plo = fmin(plo, dot3(q, e[k])), phi = fmax(phi, dot3(q, e[k]));
+                }
+                lo[k] = fmax(lo[k], plo), hi[k] = fmin(hi[k], phi);
+                for (int d = 0; d < 3 && lattice; d++)
+                    if (fabs(fabs(e[k][d]) - 1.0) < 1e-12) {
+                        double q = (c->origin[c->level][d] - cen[d]) * e[k][d] / l0;
+                        off[k] = (q - floor(q)) * l0;
+                    }
+            }
+            for (long a = (long)floor((lo[0] - off[0]) / l0); a * l0 + off[0] <= hi[0]; a++)
+                for (long b = (long)floor((lo[1] - off[1]) / l0); b * l0 + off[1] <= hi[1]; b++) {
+                    double u = off[0] + a * l0, v = off[1] + b * l0, x[3];
+                    if (u * u + v * v > rmax * rmax) continue;
+                    for (int d = 0; d < 3; d++) x[d] = cen[d] + u * e1[d] + v * e2[d];
+                    if (w->has_range &&
+                        (x[0] < w->range[0] - c->tol || x[0] > w->range[1] + c->tol))
+                        continue;
+                    push(c, x, j ? LUB_DUMMY : LUB_WALL);
+                }
+        }
+}
+
+/* The layers j0..j1 of a cylinder (layer_radius); a roller of finite length (3-D, `length`)
+ * its wall and dummy layers only (geometry.c refuses fluidLayers on it). */
 static void sample_cylinder(gen_ctx *c, const lub_wall *w, int j0, int j1)
 {
     const lub_geometry *g = c->g;
@@ -409,12 +482,17 @@ static void sample_cylinder(gen_ctx *c, const lub_wall *w, int j0, int j1)
         i0 = (long)floor(lo / l0);
         i1 = (long)ceil(hi / l0);
     }
-    for (long i = i0; i <= i1; i++) {
-        double t = t0 + i * step, cen[3];
-        for (int d = 0; d < 3; d++) cen[d] = w->centre[d] + t * w->axis[d];
-        for (int j = j0; j <= j1; j++)
-            sample_ring(c, w, cen, e1, e2, layer_radius(w, j, l0), layer_kind(j), 1);
+    if (!w->has_length) {
+        for (long i = i0; i <= i1; i++) {
+            double t = t0 + i * step, cen[3];
+            for (int d = 0; d < 3; d++) cen[d] = w->centre[d] + t * w->axis[d];
+            for (int j = j0; j <= j1; j++)
+                sample_ring(c, w, cen, e1, e2, layer_radius(w, j, l0), layer_kind(j), 1);
+        }
+        return;
     }
+    if (j0 < 0) return; /* no body-fitted fluid rows on a roller (geometry.c refuses it) */
+    sample_roller(c, w, e1, e2, t0, step, ax >= 0);
 }
 
 /* Sphere: rings of constant polar angle about the vertical axis, from the lowest point;
@@ -831,7 +909,11 @@ double lub_geometry_estimate(const lub_geometry *g)
         for (int d = 0; d < g->dim; d++) ext = fmax(ext, g->dmax[d] - g->dmin[d]);
         switch (w->type) {
         case LUB_WALL_CYLINDER:
-            total += layers * 2 * M_PI * w->radius / l0 * (g->dim == 3 ? ext / l0 : 1.0);
+            if (g->dim == 3 && w->has_length) /* rings over the length, two flat ends */
+                total += layers * (2 * M_PI * w->radius / l0 * (fmin(ext, w->length) / l0 + 1) +
+                                   2 * fmin(M_PI * w->radius * w->radius, ext * ext) / (l0 * l0));
+            else
+                total += layers * 2 * M_PI * w->radius / l0 * (g->dim == 3 ? ext / l0 : 1.0);
             break;
         case LUB_WALL_SPHERE:
             total += layers * 4 * M_PI * w->radius * w->radius / (l0 * l0);
@@ -1010,6 +1092,11 @@ static void discretise(const lub_geometry *g, lub_particles *P, int only, double
         const lub_wall *w = &g->walls[i];
         int ax = w->type == LUB_WALL_PLANE ? plane_axis(w) : -1;
         if (ax >= 0 && ax < g->dim) check_on_lattice(&c, w, ax, w->point[ax], "plane point");
+        if (w->type == LUB_WALL_CYLINDER && w->has_length)
+            for (int d = 0; d < 3; d++)
+                if (fabs(fabs(w->axis[d]) - 1.0) < 1e-12)
+                    for (int s = -1; s <= 1; s += 2)
+                        check_on_lattice(&c, w, d, w->centre[d] + s * 0.5 * w->length, "end");
         for (int d = 0; d < g->dim && w->type == LUB_WALL_BOX; d++) {
             check_on_lattice(&c, w, d, w->min[d], "min");
             check_on_lattice(&c, w, d, w->max[d], "max");

@@ -91,6 +91,19 @@ static void read_cylinder(lub_wall *w, lub_node *m, int dim)
         for (int d = 0; d < 3; d++) w->centre[d] = low[d] + w->radius * up[d];
     }
     read_range(w, m);
+    lub_node *ln = lub_dict_find(m, "length");
+    if (ln) {
+        if (dim != 3)
+            lub_node_error(ln,
+                           "cylinder '%s': 'length' makes a 3-D roller of finite length; a 2-D "
+                           "cylinder is a circle",
+                           w->name);
+        if (w->fluid_inside)
+            lub_node_error(ln, "cylinder '%s': 'length' (a roller) needs the fluid outside it",
+                           w->name);
+        w->length = lub_dict_real(m, "length", LUB_POSITIVE);
+        w->has_length = 1;
+    }
 }
 
 /* fluidLayers of a round wall: a 2-D cylinder must be a whole circle (its rings close) */
@@ -100,6 +113,11 @@ static void read_fluid_layers(lub_wall *w, lub_node *m, int dim)
     lub_node *n = lub_dict_find(m, "fluidLayers");
     if (n && w->fluid_layers > 0 && w->type == LUB_WALL_CYLINDER && dim == 2 && w->has_range)
         lub_node_error(n, "wall '%s': fluidLayers needs a whole circle (no range)", w->name);
+    if (n && w->fluid_layers > 0 && w->type == LUB_WALL_CYLINDER && w->has_length)
+        lub_node_error(n,
+                       "wall '%s': fluidLayers is for an infinitely long cylinder, not a roller "
+                       "of finite length (length)",
+                       w->name);
 }
 
 static void read_polyline(lub_wall *w, lub_node *m)
@@ -573,6 +591,14 @@ static int round_roots(const lub_wall *w, double x, double *ylo, double *yhi)
     double s = sqrt(disc);
     *ylo = (-B - s) / (2.0 * A);
     *yhi = (-B + s) / (2.0 * A);
+    if (w->type == LUB_WALL_CYLINDER && w->has_length) {
+        /* a roller of finite length: the line must meet its round surface between the ends */
+        const double c[3] = {x - w->centre[0], -w->centre[1], -w->centre[2]};
+        for (int k = 0; k < 2; k++) {
+            double y = k ? *yhi : *ylo, q[3] = {c[0], c[1] + y, c[2]};
+            if (fabs(dot3(q, w->axis)) > 0.5 * w->length * (1 + 1e-12)) return 0;
+        }
+    }
     return 1;
 }
 
@@ -714,11 +740,18 @@ double lub_wall_distance(const lub_wall *w, const double *x, int dim)
     case LUB_WALL_CYLINDER:
     case LUB_WALL_SPHERE: {
         double d[3] = {p[0] - w->centre[0], p[1] - w->centre[1], p[2] - w->centre[2]};
+        double a = 0.0;
         if (w->type == LUB_WALL_CYLINDER && dim == 3) {
-            double a = dot3(d, w->axis);
+            a = dot3(d, w->axis);
             for (int k = 0; k < 3; k++) d[k] -= a * w->axis[k];
         }
         double r = norm3(d) - w->radius;
+        if (w->type == LUB_WALL_CYLINDER && w->has_length && dim == 3) {
+            /* exact signed distance to the solid of finite length: outside, to the nearest
+             * point of its round surface or flat ends; inside, minus the nearer of them */
+            double e = fabs(a) - 0.5 * w->length;
+            r = hypot(fmax(r, 0.0), fmax(e, 0.0)) + fmin(fmax(r, e), 0.0);
+        }
         return w->fluid_inside ? -r : r;
     }
     case LUB_WALL_BOX: {

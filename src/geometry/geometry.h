@@ -25,15 +25,22 @@
  *       tank:      { type: box, min: [0, 0], max: [1.61, 0.8], fluid: inside }
  *       ball:      { type: sphere, centre: [0, 0, 1], radius: 0.1 }             # 3-D
  *       shaft:     { type: cylinder, centre: [0, 0, 1], axis: [0, 0, 1], radius: 0.1 } # 3-D
+ *       roller:    { type: cylinder, lowestPoint: [0, 4.0e-5, 0], radius: 0.01,
+ *                    length: 9.6e-4 }     # 3-D: a roller of finite length (flat ends)
  *     fluid:
  *       - { type: layer, wall: lowerWall, thickness: 8.0e-5 }   # film on a wall
  *       - { type: box, min: [0, 0], max: [0.6, 0.3] }
  *       - { type: between, lower: lowerWall, upper: cylinder, height: 8.0e-5 }
  *     jitter:      { amplitude: 0.25, seed: 1 }   # disordered start (optional)
  *
- * cylinder: `centre` or `lowestPoint`; fluid `outside` (default) or `inside`.
- * cylinder (2-D, no range; 3-D), sphere: `fluidLayers: K` (default 0) puts the first K rows
- * of fluid on the surfaces k l0 (k = 1..K) out from the wall, body-fitted (discretise.h).
+ * cylinder: `centre` or `lowestPoint`; fluid `outside` (default) or `inside`.  In 3-D it is
+ * infinitely long unless `length` is given: then it is the solid between two flat ends
+ * (discs of the radius) at length/2 either side of the centre (or lowest point) along the
+ * axis, a roller of finite length; with the axis along x, y or z its ends must lie on the
+ * particle lattice (as the faces of a box).
+ * cylinder (2-D, no range; 3-D without length), sphere: `fluidLayers: K` (default 0) puts
+ * the first K rows of fluid on the surfaces k l0 (k = 1..K) out from the wall, body-fitted
+ * (discretise.h).
  * box, sphere: fluid `inside` or `outside` (box default inside: a tank; sphere outside).
  * segment, polyline (2-D): fluid `above` (default) or `below`; polyline x must increase.
  * polygon (2-D): a closed solid body (fluid outside): at least 3 vertices in any order
@@ -77,6 +84,8 @@ typedef struct {
     int has_range;         /* cylinder arc / plane limited in x */
     double range[2];
     int fluid_layers; /* cylinder, sphere: fluid on this many surfaces k l0 out (discretise.h) */
+    int has_length; /* 3-D cylinder of finite length (flat ends) */
+    double length;  /* along the axis, centred on the centre */
 } lub_wall;
 
 typedef enum { LUB_REGION_LAYER, LUB_REGION_BOX, LUB_REGION_BETWEEN } lub_region_type;

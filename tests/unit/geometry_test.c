@@ -535,6 +535,96 @@ static void test_walls_3d(void)
     lub_geometry_free(&g);
 }
 
+/* A roller of finite length (3-D cylinder with `length`): its signed distance and section
+ * against the closed forms, its particles counted by hand, and the fluid around it against
+ * the volume of the solid.  R = 0.5, length 1 along z, l0 = 0.1, the lattice through 0 in
+ * every direction (domain from -2.05): rings of radius 0.5, 0.4, 0.3 of round(2 pi r / l0)
+ * = 31, 25, 19 points at the 11 lattice z from -0.5 to 0.5; on the end planes z = +-0.5,
+ * +-0.4, +-0.3 the lattice points inside radius R - 2.5 l0 = 0.25: i^2 + j^2 <= 6.25 for
+ * |i|, |j| <= 2, the 25 but the 4 corners (8 > 6.25): 21. */
+static void test_roller(void)
+{
+    lub_geometry g;
+    lub_particles P;
+    size_t rc[1];
+    generate("dimension: 3\nl0: 0.1\n"
+             "domain: { min: [-2.05, -2.05, -2.05], max: [2.05, 2.05, 2.05] }\n"
+             "walls:\n  roller: { type: cylinder, centre: [0, 0, 0], radius: 0.5, length: 1 }\n"
+             "fluid:\n  - { type: box, min: [-1, -1, -1], max: [1, 1, 1] }\n",
+             &g, &P, rc);
+    const lub_wall *w = &g.walls[0];
+    /* distance: beside the round surface, beyond an end, off the rim, inside */
+    CHECK_NEAR(lub_wall_distance(w, (double[]){0.8, 0, 0}, 3), 0.3, 1e-14);
+    CHECK_NEAR(lub_wall_distance(w, (double[]){0, 0.2, -0.9}, 3), 0.4, 1e-14);
+    CHECK_NEAR(lub_wall_distance(w, (double[]){0, -0.8, 0.9}, 3), 0.5, 1e-14);
+    CHECK_NEAR(lub_wall_distance(w, (double[]){0.1, 0, 0.3}, 3), -0.2, 1e-14);
+    CHECK_NEAR(lub_wall_distance(w, (double[]){0.35, 0, 0.1}, 3), -0.15, 1e-14);
+    double y;
+    CHECK(lub_wall_height(w, 0.3, 1, &y) && fabs(y + 0.4) < 1e-14); /* the z = 0 section */
+    size_t rings = 11 * (31 + 25 + 19), ends = 2 * 3 * 21;
+    size_t nw = 0, nd = 0, bad = 0;
+    for (size_t i = 0; i < P.n; i++) {
+        if (P.kind[i] == LUB_FLUID) continue;
+        double x = P.x[0][i], yy = P.x[1][i], z = P.x[2][i], r = hypot(x, yy);
+        /* depth behind the surface: the smaller of the radial and the axial one */
+        double depth = fmin(0.5 - r, 0.5 - fabs(z));
+        if (depth < -1e-12 || depth > 0.2 + 1e-12) bad++;
+        if ((P.kind[i] == LUB_WALL) != (depth < 1e-9)) bad++;
+        if (P.kind[i] == LUB_WALL)
+            nw++;
+        else
+            nd++;
+    }
+    CHECK(bad == 0);
+    CHECK(nw + nd == rings + ends);
+    /* walls: the outer rings, the inner rings on the end planes, the end grids' outer layer */
+    CHECK(nw == 11 * 31 + 2 * (25 + 19) + 2 * 21);
+    CHECK(lub_geometry_estimate(&g) >= (double)P.n);
+    /* the fluid: the box's 21^3 lattice points but the solid and a shell of up to 1 l0
+     * (wallGap) around it, between the solids grown by 0.4 l0 and by 1.1 l0 */
+    const double l0 = 0.1, R = 0.5, L = 1.0;
+    double out = (double)(21 * 21 * 21) - (double)rc[0];
+    CHECK(out * pow(l0, 3) > M_PI * pow(R + 0.4 * l0, 2) * (L + 0.8 * l0));
+    CHECK(out * pow(l0, 3) < M_PI * pow(R + 1.1 * l0, 2) * (L + 2.2 * l0));
+    CHECK(count_of(&P, LUB_FLUID, -1) == rc[0]);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
+
+    /* the lowest point, a section beside the roller (no height), an axis along x */
+    read_text(&g, "dimension: 3\nl0: 0.1\ndomain: { min: [-3, -3, -3], max: [3, 3, 3] }\n"
+                  "walls:\n  a: { type: cylinder, lowestPoint: [0, 0.1, 2], radius: 1, "
+                  "length: 1 }\n"
+                  "  b: { type: cylinder, centre: [0, 0, 0], axis: [1, 0, 0], radius: 1, "
+                  "length: 2 }\n");
+    CHECK(!lub_wall_height(&g.walls[0], 0.0, 1, &y)); /* z = 0 lies beyond its end at 1.5 */
+    CHECK(lub_wall_height(&g.walls[1], 0.9, 1, &y) && fabs(y + 1) < 1e-14);
+    CHECK(!lub_wall_height(&g.walls[1], 1.1, 1, &y));
+    CHECK_NEAR(lub_wall_distance(&g.walls[1], (double[]){1.5, 0, 0}, 3), 0.5, 1e-14);
+    lub_geometry_free(&g);
+
+    CHECK_BAD("dimension: 2\nl0: 0.1\ndomain: { min: [-1, -1], max: [1, 1] }\nwalls:\n"
+              "  c: { type: cylinder, centre: [0, 0], radius: 0.5, length: 1 }\n",
+              5, "'length' makes a 3-D roller");
+    CHECK_BAD("dimension: 3\nl0: 0.1\ndomain: { min: [-1, -1, -1], max: [1, 1, 1] }\nwalls:\n"
+              "  c: { type: cylinder, centre: [0, 0, 0], radius: 0.5, length: 1,\n"
+              "       fluid: inside }\n",
+              5, "needs the fluid outside");
+    CHECK_BAD("dimension: 3\nl0: 0.1\ndomain: { min: [-1, -1, -1], max: [1, 1, 1] }\nwalls:\n"
+              "  c: { type: cylinder, centre: [0, 0, 0], radius: 0.5, length: -1 }\n",
+              5, "length");
+    /* body-fitted fluid rows (fluidLayers) are for a whole, infinitely long cylinder */
+    CHECK_BAD(
+        "dimension: 3\nl0: 0.1\ndomain: { min: [-1, -1, -1], max: [1, 1, 1] }\nwalls:\n"
+        "  c: { type: cylinder, centre: [0, 0, 0], radius: 0.5, length: 1, fluidLayers: 2 }\n",
+        5, "not a roller of finite length");
+    read_text(&g, "dimension: 3\nl0: 0.1\n"
+                  "domain: { min: [-2.05, -2.05, -2.05], max: [2.05, 2.05, 2.05] }\n"
+                  "walls:\n  roller: { type: cylinder, centre: [0, 0, 0], radius: 0.5, "
+                  "length: 1.05 }\n");
+    CHECK_FATAL(lub_geometry_discretise(&g, &P, 0.0, NULL), "end z = -0.525 is not on the");
+    lub_geometry_free(&g);
+}
+
 /* Bad input found while discretising: empty region, off-lattice wall, too many particles. */
 static void test_bad_discretise(void)
 {
@@ -1097,6 +1187,7 @@ int main(void)
     RUN(test_levels_arc);
     RUN(test_tank_3d);
     RUN(test_walls_3d);
+    RUN(test_roller);
     RUN(test_curves);
     RUN(test_between);
     RUN(test_bad_discretise);

@@ -6,6 +6,9 @@
  *       wallPressure: { type: wallPressure, patch: cylinder, bin: 2.5e-5,
  *                       from: -0.0045, to: 0.0045,             # x range (default: domain)
  *                       timeStart: 0.024, timeEnd: 0.030 }     # averaging window
+ *                     (3-D: `zRange: [z0, z1]` takes only the wall particles with z in
+ *                     [z0, z1], e.g. the mid-plane row of a finite bearing; without it the
+ *                     bins pool every z)
  *
  * totals.dat:  # t[s] mass[kg/m] momentumX[kg/s] momentumY[kg/s] momentumZ[kg/s]
  *              kineticEnergy[J/m] fluidParticles (3-D: [kg], [kg*m/s], [J])
@@ -34,8 +37,10 @@
  * load.dat:    # t[s] load[N/m] particles   the load of the step: the integral over
  *              [from, to] of the wall pressure of the patch at that step, binned as
  *              wallPressure bins it (the mean pressure of the bin's wall particles times the
- *              bin width; a bin with no wall particle adds nothing; 3-D: the mean over z,
- *              per unit width), and the number of wall particles counted.  One row per step
+ *              bin width; a bin with no wall particle adds nothing; 3-D: the mean over z
+ *              (over zRange when given), per unit width: times z1 - z0 it is the load over
+ *              the strip when the wall particles lie in rows l0 apart and z1 - z0 is their
+ *              count times l0), and the number of wall particles counted.  One row per step
  *              (or per `interval` steps) inside the window, appended during the run: the
  *              per-step history of what wallPressure averages, to see whether the window
  *              holds one steady state.
@@ -65,6 +70,8 @@ typedef struct {
     /* wallPressure */
     int patch;
     double from, to, bin, t0, t1;
+    int has_z; /* 3-D: only the wall particles with z in [z0, z1] */
+    double z0, z1;
     int nbins;
     double *sum;
     long *count;
@@ -306,6 +313,22 @@ lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
             if (!(o->to > o->from))
                 lub_node_error(d, "function '%s': 'to' (%g) must be greater than 'from' (%g)", name,
                                o->to, o->from);
+            lub_node *zn = lub_dict_find(d, "zRange");
+            if (zn) {
+                double z[2];
+                if (r->P.dim != 3)
+                    lub_node_error(zn,
+                                   "function '%s': 'zRange' needs a 3-D case (this one is "
+                                   "2-D)",
+                                   name);
+                lub_dict_vec(d, "zRange", z, 2, 2, LUB_ANY);
+                if (!(z[0] <= z[1]))
+                    lub_node_error(zn,
+                                   "function '%s': 'zRange' is [z0, z1] with z0 <= z1, found "
+                                   "[%g, %g]",
+                                   name, z[0], z[1]);
+                o->has_z = 1, o->z0 = z[0], o->z1 = z[1];
+            }
             o->bin = lub_dict_real_or(d, "bin", 4 * r->scene.level[0]->l0, LUB_POSITIVE);
             o->t0 = lub_dict_real_or(d, "timeStart", 0.0, LUB_NONNEGATIVE);
             o->t1 = lub_dict_real_or(d, "timeEnd", INFINITY, LUB_NONNEGATIVE);
@@ -410,6 +433,7 @@ static void wall_pressure_bin(fo *o, const lubfoam_run *r)
         if (P->kind[i] != LUB_WALL || P->patch[i] != o->patch) continue;
         double x = P->x[0][i];
         if (x < o->from || x >= o->to) continue;
+        if (o->has_z && !(P->x[2][i] >= o->z0 && P->x[2][i] <= o->z1)) continue;
         /* resolution levels: each x on the level that owns it */
         if (r->scene.nlevels > 1 && lub_scene_owner(&r->scene, x) != P->level[i]) continue;
         int b = (int)((x - o->from) / o->bin);

@@ -118,6 +118,12 @@ static const char *description =
     "system/particleGenDict.yaml (with -arc, the extent of the patch); default DX: 4 l0 (line,\n"
     "film).\n"
     "\n"
+    "z-range (3-D): -z Z0:Z1 (probeDict: z: [Z0, Z1]) keeps only the particles with z in\n"
+    "[Z0, Z1] for wallPressure, line and film: a slab across the width, e.g. the mid-plane\n"
+    "of a bearing of finite width (-z -5e-6:5e-6 takes the particle row at z = 0 at l0 =\n"
+    "1e-5), or the rows near its side (line -field Uz: the side leakage).  A 2-D case, or a\n"
+    "slab with no particle, is an error.\n"
+    "\n"
     "Times: every time folder unless -time, -latestTime or -noZero select some.  With one time,\n"
     "or with -average, the output is one table that postErr reads directly.  With several\n"
     "times and no -average a leading column t (the time folder) is added and the rows of all\n"
@@ -159,15 +165,31 @@ static const char *description =
     "-at point list or -average window, and bad dictionaries (file:line).";
 
 /* Which options each subcommand takes. */
-enum { O_PATCH, O_FIELD, O_FROM, O_TO, O_BIN, O_ARC, O_AT, O_DIMLESS, O_FACING, O_HISTORY, O_N };
-static const char *const opt_names[O_N] = {"-patch",  "-field",  "-from", "-to",
-                                           "-bin",    "-arc",    "-at",   "-dimensionless",
-                                           "-facing", "-history"};
+enum {
+    O_PATCH,
+    O_FIELD,
+    O_FROM,
+    O_TO,
+    O_BIN,
+    O_ARC,
+    O_AT,
+    O_DIMLESS,
+    O_FACING,
+    O_HISTORY,
+    O_Z,
+    O_N
+};
+static const char *const opt_names[O_N] = {"-patch",  "-field",   "-from", "-to",
+                                           "-bin",    "-arc",     "-at",   "-dimensionless",
+                                           "-facing", "-history", "-z"};
 static const int applies[PROBE_NKINDS][O_N] = {
-    [PROBE_WALL] = {1, 1, 1, 1, 1, 1, 0, 1, 1, 0},   [PROBE_LINE] = {0, 1, 1, 1, 1, 0, 0, 1, 0, 0},
-    [PROBE_POINTS] = {0, 1, 0, 0, 0, 0, 1, 1, 0, 1}, [PROBE_FILM] = {0, 0, 1, 1, 1, 0, 0, 1, 0, 0},
-    [PROBE_TOTALS] = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0}, [PROBE_SHAPE] = {1, 0, 1, 1, 0, 0, 0, 1, 0, 0},
-    [PROBE_FRONT] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0},
+    [PROBE_WALL] = {1, 1, 1, 1, 1, 1, 0, 1, 1, 0, 1},
+    [PROBE_LINE] = {0, 1, 1, 1, 1, 0, 0, 1, 0, 0, 1},
+    [PROBE_POINTS] = {0, 1, 0, 0, 0, 0, 1, 1, 0, 1, 0},
+    [PROBE_FILM] = {0, 0, 1, 1, 1, 0, 0, 1, 0, 0, 1},
+    [PROBE_TOTALS] = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0},
+    [PROBE_SHAPE] = {1, 0, 1, 1, 0, 0, 0, 1, 0, 0, 0},
+    [PROBE_FRONT] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0},
 };
 
 static const char *in_case(const lub_case *c, const char *path, char *buf)
@@ -192,7 +214,7 @@ static probe_kind find_kind(const char *name)
 int main(int argc, char **argv)
 {
     static const char *patch = NULL, *field = NULL, *at = NULL, *average = NULL, *out = NULL,
-                      *facing = NULL;
+                      *facing = NULL, *zr = NULL;
     static double from = NAN, to = NAN, bin = NAN;
     static int arc = 0, dimensionless = 0, history = 0;
     static lub_strlist set_names = {0};
@@ -210,6 +232,8 @@ int main(int argc, char **argv)
          "(upper) face",
          LUB_OPT_STR, &facing},
         {"-at", "'x y; x y'", "points: where to sample", LUB_OPT_STR, &at},
+        {"-z", "Z0:Z1", "wallPressure, line, film (3-D): only the particles with z in [Z0, Z1]",
+         LUB_OPT_STR, &zr},
         {"-history", NULL, "points: one point, one row per time: '# t p n'", LUB_OPT_FLAG,
          &history},
         {"-average", "T0:T1", "average over the selected times in [T0, T1]", LUB_OPT_STR, &average},
@@ -256,8 +280,11 @@ int main(int argc, char **argv)
         else
             lub_fatal("-facing '%s': expected down or up", facing);
     }
-    int given[O_N] = {patch != NULL, field != NULL, !isnan(from),  !isnan(to),     !isnan(bin),
-                      arc,           at != NULL,    dimensionless, facing != NULL, history};
+    double z0 = NAN, z1 = NAN;
+    if (zr && probe_parse_window(zr, &z0, &z1))
+        lub_fatal("-z '%s': expected a z-range Z0:Z1 with Z0 <= Z1, e.g. -z -5e-6:5e-6", zr);
+    int given[O_N] = {patch != NULL, field != NULL, !isnan(from),   !isnan(to), !isnan(bin), arc,
+                      at != NULL,    dimensionless, facing != NULL, history,    zr != NULL};
 
     probe_ctx x;
     memset(&x, 0, sizeof x);
@@ -293,6 +320,7 @@ int main(int argc, char **argv)
         s.facing = facing_dir;
         s.dimensionless = dimensionless;
         s.history = history;
+        if (zr) s.has_z = 1, s.z0 = z0, s.z1 = z1;
         if (average) s.average = 1, s.t0 = t0, s.t1 = t1;
         char err[512];
         if (at && probe_parse_points(&s, at, err, sizeof err)) {

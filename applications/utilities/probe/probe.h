@@ -39,8 +39,10 @@ typedef struct {
     const char *patch; /* wallPressure, wallShape; totals: the load on this patch */
     char fields[1024]; /* comma-separated field list (default "p") */
     double from, to, bin;
-    int arc;     /* wallPressure: against arc length */
-    int facing;  /* wallPressure: -1 (+1) only the wall particles facing down (up), 0 all */
+    int arc;    /* wallPressure: against arc length */
+    int facing; /* wallPressure: -1 (+1) only the wall particles facing down (up), 0 all */
+    int has_z;  /* wallPressure, line, film (3-D): only the particles with z in [z0, z1] */
+    double z0, z1;
     double *pts; /* points: npts x 3 (z = 0 in 2-D), owned */
     size_t npts;
     int pts_dim; /* coordinates given per point */
@@ -49,7 +51,7 @@ typedef struct {
     double t0, t1;
     int dimensionless;
     /* where each setting came from, for messages: a dictionary entry, or NULL for options */
-    const lub_node *node, *patch_node, *field_node, *at_node, *average_node, *history_node;
+    const lub_node *node, *patch_node, *field_node, *at_node, *average_node, *history_node, *z_node;
 } probe_spec;
 
 void probe_spec_init(probe_spec *s, probe_kind kind, const char *name);

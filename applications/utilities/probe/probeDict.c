@@ -215,6 +215,17 @@ static void read_set(probe_spec *s, const char *name, lub_node *m)
             lub_node_error(lub_dict_get(m, "to"), "'to' (%g) must be greater than 'from' (%g)",
                            s->to, s->from);
     }
+    if (kind == PROBE_WALL || kind == PROBE_LINE || kind == PROBE_FILM) {
+        lub_node *zn = lub_dict_find(m, "z");
+        if (zn) {
+            double z[2];
+            lub_dict_vec(m, "z", z, 2, 2, LUB_ANY);
+            if (!(z[0] <= z[1]))
+                lub_node_error(zn, "'%s' is a z-range [Z0, Z1] with Z0 <= Z1, found [%g, %g]",
+                               lub_node_path(zn), z[0], z[1]);
+            s->has_z = 1, s->z0 = z[0], s->z1 = z[1], s->z_node = zn;
+        }
+    }
     if (kind == PROBE_POINTS) {
         read_points(s, m);
         s->history_node = lub_dict_find(m, "history");

@@ -190,6 +190,32 @@ static void job_times(job *j)
     j->nt = m;
 }
 
+/* -z Z0:Z1 (3-D): keep the particles with z in [z0, z1] (a slab across the width, e.g. the
+ * mid-plane of a finite bearing), in their order; every sampler then sees the slab alone. */
+static void keep_slab(job *j)
+{
+    lub_particles *P = &j->P;
+    if (P->dim != 3)
+        probe_error(j->s->z_node, "%sa z-range needs a 3-D case; %s is %d-D",
+                    j->s->z_node ? "" : "-z: ", j->file, P->dim);
+    size_t m = 0;
+    for (size_t i = 0; i < P->n; i++) {
+        if (!(P->x[2][i] >= j->s->z0 && P->x[2][i] <= j->s->z1)) continue;
+        for (int d = 0; d < 3; d++) P->x[d][m] = P->x[d][i], P->u[d][m] = P->u[d][i];
+        P->p[m] = P->p[i];
+        P->kind[m] = P->kind[i];
+        P->patch[m] = P->patch[i];
+        P->level[m] = P->level[i];
+        P->id[m] = P->id[i];
+        for (int e = 0; e < P->nextra; e++) P->extra[e].v[m] = P->extra[e].v[i];
+        m++;
+    }
+    if (m == 0)
+        probe_error(j->s->z_node, "%sno particle of %s has z in [%g, %g]",
+                    j->s->z_node ? "" : "-z: ", j->file, j->s->z0, j->s->z1);
+    P->n = m;
+}
+
 static void job_read(job *j, size_t it)
 {
     struct stat st;
@@ -198,6 +224,7 @@ static void job_read(job *j, size_t it)
         lub_fatal("time folder '%s' of case '%s' has no particles.h5 (%s)", j->times[it].name,
                   j->x->c.root, j->file);
     lub_particles_read(&j->P, j->file);
+    if (j->s->has_z) keep_slab(j);
 }
 
 /* Fields of the set, resolved against the first time folder. */
