@@ -44,6 +44,15 @@
  *              (or per `interval` steps) inside the window, appended during the run: the
  *              per-step history of what wallPressure averages, to see whether the window
  *              holds one steady state.
+ *       forces:       { type: forces, patch: arc, interval: 10 }   # every 10 steps
+ *
+ * forces.dat:  # t[s] Fx[N/m] Fy[N/m] Fz[N/m]   the force the fluid exerted on the patch in
+ *              the step (2-D: per unit depth; 3-D: [N]), the sum over its wall and dummy
+ *              particles of the fluid's wall_forces (models/fluid.h): with the MPH fluid
+ *              the pair forces of (K-6) and of the surface tension (K-8) on them, the load
+ *              with the adhesion of the surface-tension model, which the wall pressure pLoad
+ *              (pressure pairs only) leaves out.  MPH only: the MPS fluid's wall force needs
+ *              the body's shape (rigidBodies); wallLoad gives the MPS load.
  * The cost table (postProcessing/cost/<startTime>/cost.dat) is written by lubFoam itself.
  *
  * The models' own tables (elasticWall.dat: src/models/elasticWall/io.c) are opened and
@@ -60,13 +69,15 @@
 #include "lubFoam.h"
 #include "models/multiResolution/levels.h"
 
-enum { FO_TOTALS, FO_WALLPRESSURE, FO_WALLLOAD };
+enum { FO_TOTALS, FO_WALLPRESSURE, FO_WALLLOAD, FO_FORCES };
 
 typedef struct {
     int type;
     char name[64];
     long interval;
-    FILE *fp; /* totals, wallLoad: appended during the run */
+    FILE *fp;     /* totals, wallLoad, forces: appended during the run */
+    double *f[3]; /* forces: the fluid's force on each particle, allocated once */
+    size_t fcap;  /* forces: their length */
     /* wallPressure */
     int patch;
     double from, to, bin, t0, t1;
@@ -283,7 +294,7 @@ int lubfoam_functions_count(const lubfoam_functions *f)
 
 lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
 {
-    static const char *const types[] = {"totals", "wallPressure", "wallLoad", NULL};
+    static const char *const types[] = {"totals", "wallPressure", "wallLoad", "forces", NULL};
     lubfoam_functions *F = lub_calloc(1, sizeof *F);
     lub_node *fs = r->ctl.functions;
     size_t n = fs ? lub_node_size(fs) : 0;
@@ -307,6 +318,18 @@ lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
                 lub_node_error(lub_dict_get(d, "patch"),
                                "function '%s': no patch '%s' in the particles (patches: %s)", name,
                                patch, list);
+            }
+            if (o->type == FO_FORCES) {
+                /* the pair-force formulation needs no body shape (models/fluid.h) */
+                if (strcmp(r->scene.fluid->name, "mph") != 0 || !r->scene.fluid->wall_forces)
+                    lub_node_error(lub_dict_get(d, "type"),
+                                   "function '%s': forces needs the fluid 'mph' (constant/"
+                                   "models.yaml fluid: { type: mph }), whose wall force is a sum "
+                                   "of pair forces; with '%s' use wallLoad",
+                                   name, r->scene.fluid->name);
+                o->fcap = r->P.cap > r->P.n ? r->P.cap : r->P.n + 1;
+                for (int c = 0; c < 3; c++) o->f[c] = lub_calloc(o->fcap, sizeof(double));
+                continue;
             }
             o->from = lub_dict_real_or(d, "from", r->scene.level[0]->lo[0], LUB_ANY);
             o->to = lub_dict_real_or(d, "to", r->scene.level[0]->hi[0], LUB_ANY);
@@ -370,6 +393,14 @@ void lubfoam_functions_start(lubfoam_functions *F, lubfoam_run *r)
                                        "momentumZ[kg*m/s] kineticEnergy[J] fluidParticles");
             /* on disk at once: a run killed before the first row leaves a table with its
              * header, not an empty file */
+            fflush(o->fp);
+        } else if (o->type == FO_FORCES) {
+            char path[LUB_PATH_MAX];
+            lub_postproc_path(&r->cs, o->name, r->start_name, "forces.dat", path);
+            o->fp = fopen(path, "w");
+            if (!o->fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+            lub_table_write_header(o->fp, r->P.dim == 2 ? "t[s] Fx[N/m] Fy[N/m] Fz[N/m]"
+                                                        : "t[s] Fx[N] Fy[N] Fz[N]");
             fflush(o->fp);
         } else if (o->type == FO_WALLLOAD) {
             char path[LUB_PATH_MAX];
@@ -475,6 +506,23 @@ static void wall_load(fo *o, lubfoam_run *r)
     lub_table_write_row(o->fp, row, 3);
 }
 
+/* The force of the fluid on o's patch in the step just taken (models/fluid.h wall_forces;
+ * MPH: pair forces, so no area vectors and no angular velocity are needed). */
+static void forces(fo *o, lubfoam_run *r)
+{
+    const lub_particles *P = &r->P;
+    if (P->n > o->fcap) lub_bug("forces: %zu particles, %zu allocated", P->n, o->fcap);
+    double *none[3] = {NULL, NULL, NULL};
+    const double omega[3] = {0, 0, 0};
+    r->scene.fluid->wall_forces(r->scene.level[0], o->patch, none, omega, o->f);
+    double F[3] = {0, 0, 0};
+    for (size_t i = 0; i < P->n; i++)
+        if (P->kind[i] != LUB_FLUID && P->patch[i] == o->patch)
+            for (int d = 0; d < 3; d++) F[d] += o->f[d][i];
+    double row[4] = {r->t, F[0], F[1], F[2]};
+    lub_table_write_row(o->fp, row, 4);
+}
+
 void lubfoam_functions_execute(lubfoam_functions *F, lubfoam_run *r)
 {
     lub_scene_functions_execute(&r->scene, r->t, r->step);
@@ -485,6 +533,8 @@ void lubfoam_functions_execute(lubfoam_functions *F, lubfoam_run *r)
             totals(o, r);
         else if (o->type == FO_WALLLOAD)
             wall_load(o, r);
+        else if (o->type == FO_FORCES)
+            forces(o, r);
         else
             wall_pressure(o, r);
     }
@@ -494,7 +544,8 @@ void lubfoam_functions_write(lubfoam_functions *F, lubfoam_run *r)
 {
     for (int k = 0; k < F->n; k++) {
         fo *o = &F->f[k];
-        if (o->type == FO_WALLLOAD) fflush(o->fp); /* rows kept in stdio's buffer between writes */
+        /* rows kept in stdio's buffer between writes */
+        if (o->type == FO_WALLLOAD || o->type == FO_FORCES) fflush(o->fp);
         /* nothing averaged (outside the window): no table, which would hide the earlier
          * run's average from whoever takes the latest start time's */
         if (o->type != FO_WALLPRESSURE || !o->samples) continue;
@@ -550,6 +601,7 @@ void lubfoam_functions_free(lubfoam_functions *F)
         if (F->f[k].fp) fclose(F->f[k].fp);
         free(F->f[k].sum);
         free(F->f[k].count);
+        for (int d = 0; d < 3; d++) free(F->f[k].f[d]);
     }
     free(F->f);
     free(F);

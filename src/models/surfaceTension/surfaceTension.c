@@ -68,7 +68,9 @@ typedef struct {
     double *na, *chi[3];
     double *pc;            /* the particle field pCohesive: a N_i, the cohesive (CPP) pressure */
     int walls_done;        /* the walls' own parts formed */
-    double *naw, *chiw[3]; /* the walls' own n^a and chi (wall and dummy particles) */
+    double *naw, *chiw[3]; /* the walls' own n^a and chi, by particle id (the particles are
+                              sorted every reorderInterval steps: an index does not last) */
+    size_t nid;            /* their length: the largest id + 1 */
 } surface;
 
 /* w^a(r, h) = (r/h)(1 - r/h)^2 / (S_a h^d), S_a = pi/(15 l0^d); l0^-d int w^a dV = 1 */
@@ -203,9 +205,7 @@ static void st_init(lub_model *m, lub_scene *s)
     S->cap = s->P->cap > s->P->n ? s->P->cap : s->P->n;
     S->na = lub_calloc(S->cap ? S->cap : 1, sizeof(double));
     for (int d = 0; d < 3; d++) S->chi[d] = lub_calloc(S->cap ? S->cap : 1, sizeof(double));
-    S->naw = lub_calloc(S->cap ? S->cap : 1, sizeof(double));
     S->pc = lub_particles_extra(s->P, "pCohesive");
-    for (int d = 0; d < 3; d++) S->chiw[d] = lub_calloc(S->cap ? S->cap : 1, sizeof(double));
 }
 
 /* The walls' own n^a and chi from their wall and dummy neighbours, by a search of their own
@@ -218,6 +218,14 @@ static void walls_own(surface *S, const lub_mps *f)
     for (size_t i = 0; i < P->n; i++) nw += P->kind[i] != LUB_FLUID;
     S->walls_done = 1;
     if (!nw) return;
+    /* kept by particle id, not index: lub_mps_reorder sorts the particles' own arrays, not
+     * these, and a wall particle's index moves as fluid particles change cells */
+    uint64_t maxid = 0;
+    for (size_t i = 0; i < P->n; i++)
+        if (P->kind[i] != LUB_FLUID && P->id[i] > maxid) maxid = P->id[i];
+    S->nid = (size_t)maxid + 1;
+    S->naw = lub_calloc(S->nid, sizeof(double));
+    for (int d = 0; d < 3; d++) S->chiw[d] = lub_calloc(S->nid, sizeof(double));
     double *x[3] = {NULL, NULL, NULL};
     size_t *idx = lub_malloc(nw * sizeof *idx);
     for (int d = 0; d < dim; d++) x[d] = lub_malloc(nw * sizeof(double));
@@ -241,8 +249,8 @@ static void walls_own(surface *S, const lub_mps *f)
             const double wg = lub_mph_w(dim, S->l0, S->hs, r);
             for (int d = 0; d < dim; d++) chi[d] += nb.dx[d][q] * wg;
         }
-        S->naw[i] = n;
-        for (int d = 0; d < dim; d++) S->chiw[d][i] = chi[d];
+        S->naw[P->id[i]] = n;
+        for (int d = 0; d < dim; d++) S->chiw[d][P->id[i]] = chi[d];
     }
     lub_neighbours_free(&nb);
     free(idx);
@@ -264,8 +272,12 @@ static int st_particle_forces(lub_model *m, const lub_mps *f, double *const acc[
      * its share of its wall neighbours', c w) */
     for (size_t i = 0; i < P->n; i++) {
         const int fl = P->kind[i] == LUB_FLUID;
-        S->na[i] = fl ? 0.0 : S->naw[i];
-        for (int d = 0; d < 3; d++) S->chi[d][i] = fl || d >= dim ? 0.0 : S->chiw[d][i];
+        const uint64_t id = P->id[i];
+        if (!fl && id >= S->nid)
+            lub_bug("surfaceTension: wall particle id %llu, %zu kept", (unsigned long long)id,
+                    S->nid);
+        S->na[i] = fl ? 0.0 : S->naw[id];
+        for (int d = 0; d < 3; d++) S->chi[d][i] = fl || d >= dim ? 0.0 : S->chiw[d][id];
     }
     for (size_t i = 0; i < P->n; i++) {
         if (P->kind[i] != LUB_FLUID) continue;
