@@ -648,9 +648,9 @@ static int open_side(const lub_mps *m, size_t i, const double c[3], double ccos)
 static void compression(lub_mps *m)
 {
     const lub_particles *P = m->P;
-    const size_t n = P->n;
+    const size_t n = m->par ? m->par->nown : P->n; /* on several ranks: the owned, summed */
     const double lim = m->c.beta * m->n0;
-    double sum = 0, big = 0;
+    double sum = 0, big = -INFINITY;
     size_t k = 0;
 #pragma omp parallel for schedule(static) reduction(+ : sum, k) reduction(max : big)
     for (size_t i = 0; i < n; i++) {
@@ -659,6 +659,11 @@ static void compression(lub_mps *m)
         sum += e;
         k++;
         if (e > big) big = e;
+    }
+    if (m->par) {
+        sum = lub_par_sum(sum);
+        k = (size_t)lub_par_sum_long((long)k);
+        big = lub_par_max(big);
     }
     m->st.compression = k ? sum / (double)k : 0.0;
     m->st.compression_max = k ? big : 0.0;
