@@ -6,7 +6,7 @@
  *     gradient:         lsmps        # standard (T-13) | lsmps (T-15)
  *     minPressureShift: true         # p_hat of T-14 in the gradient
  *     negativePressure: clip         # clip | keep | cavitation
- *     dummyVelocity:    mirror       # mirror (no-slip ghost 2 U - u_i) | wall (U)
+ *     dummyVelocity:    mirror       # mirror (ghost 2 U - u_i) | wall (U) | extrapolate
  *     pressure:         { alpha: 0, gamma: 0.2, predictor: 0.1 }   # T-9; lub_mps_step
  *     freeSurface:      { beta: 0.97, asymmetry: 0.2, test: sector, sectorAngle: 60,
  *                         exposedAngle: 150 }
@@ -61,7 +61,7 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->lap_pressure = LUB_LAPLACIAN_STANDARD;
     c->lsmps_rcond = LUB_LSMPS_RCOND_MIN;
     c->order_rows = 0;
-    c->mirror_dummies = 1;
+    c->dummy_velocity = LUB_DUMMY_MIRROR;
     c->p_solver = lub_linsolver_defaults();
     c->p_solver.pcg.tolerance = 1e-8;
     c->p_solver.pcg.precond = LUB_PRECOND_AMG;
@@ -100,14 +100,14 @@ static void read_schemes(lub_mps_config *c, const char *path)
 {
     static const char *const grad[] = {"standard", "lsmps", NULL};
     static const char *const neg[] = {"keep", "clip", "cavitation", NULL};
-    static const char *const dummy[] = {"wall", "mirror", NULL};
+    static const char *const dummy[] = {"wall", "mirror", "extrapolate", NULL};
     lub_dict *d = lub_dict_read(path);
     lub_node *r = lub_dict_root(d);
     c->re_l0 = lub_dict_real_or(r, "effectiveRadius", 3.1, LUB_BETWEEN(1.5, 6.0));
     c->gradient = lub_dict_choice(r, "gradient", grad, LUB_GRADIENT_LSMPS);
     c->min_pressure_shift = lub_dict_bool_or(r, "minPressureShift", 1);
     c->clip_negative = lub_dict_choice(r, "negativePressure", neg, LUB_NEGATIVE_CLIP);
-    c->mirror_dummies = lub_dict_choice(r, "dummyVelocity", dummy, c->mirror_dummies);
+    c->dummy_velocity = lub_dict_choice(r, "dummyVelocity", dummy, c->dummy_velocity);
     lub_node *p = lub_dict_map_or(r, "pressure");
     c->alpha = lub_dict_real_or(p, "alpha", 0.0, LUB_NONNEGATIVE);
     c->gamma = lub_dict_real_or(p, "gamma", 0.2, (lub_range){0.0, 1.0, 1, 0});

@@ -65,6 +65,8 @@ enum { LUB_VISCOSITY_NONE = 0, LUB_VISCOSITY_EXPLICIT = 1, LUB_VISCOSITY_CN = 2 
 enum { LUB_NEGATIVE_KEEP = 0, LUB_NEGATIVE_CLIP = 1, LUB_NEGATIVE_CAVITATION = 2 };
 enum { LUB_SURFACE_SECTOR = 0, LUB_SURFACE_CENTROID = 1, LUB_SURFACE_PND = 2 };
 enum { LUB_LAPLACIAN_STANDARD = 0, LUB_LAPLACIAN_LSMPS = 1 };
+/* dummyVelocity: the wall's U, the mirror ghost 2 U - u_i, or the no-slip profile extrapolated */
+enum { LUB_DUMMY_WALL = 0, LUB_DUMMY_MIRROR = 1, LUB_DUMMY_EXTRAPOLATE = 2 };
 
 typedef struct {
     /* system/schemes.yaml */
@@ -92,7 +94,8 @@ typedef struct {
     double lsmps_rcond;     /* LSMPS Laplacian: smallest pivot ratio of M_i (mps/lsmps.h) */
     int reorder_interval;   /* steps between sorts of the particles (0: never) */
     int order_rows;         /* the sort: 0 cell order, 1 lattice rows of l0 */
-    int mirror_dummies;     /* dummies take the no-slip ghost velocity 2 U - u_i (viscosity) */
+    int dummy_velocity;     /* LUB_DUMMY_*: the dummies' velocity in the viscous term (step.c,
+                               dummy_velocity) */
     double list_l0;         /* set by the fluid's formulation or a model, not read: the
                                neighbour lists reach at least list_l0 l0 when built (MPH:
                                h_v = 3.5 l0, models/fluid/mph.c), by a larger skin; their
@@ -213,6 +216,9 @@ struct lub_mps {
     double *b, *x;         /* right-hand side and solution (pressure) */
     double *bv[3], *xv[3]; /* viscosity */
     double *grad[3];
+    double *kap[3];  /* dummyVelocity extrapolate: the curvature of the no-slip profile the
+                        viscous step of the last step took at each fluid particle, (G/rho -
+                        g)/nu (step.c, dummy_velocity), for the wall forces; else NULL */
     double *gbar[3]; /* predictor: running mean of the pressure gradient (particle extra
                         fields gradPx, gradPy, gradPz, so that it is saved and reordered) */
     double *cav;     /* negativePressure cavitation: 1 where the pressure is held at 0 (particle
@@ -301,6 +307,32 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
  * and msg as for lub_mps_step.  Uses the neighbour lists of the step: a caller that places
  * particles itself builds them first (lub_neighbours_build(&m->nb, P->n, P->x)). */
 lub_step_status lub_mps_check(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize);
+
+/* The wall of patch `patch` around fluid particle i, as the least-squares line (plane in 3-D)
+ * through the patch's wall particles within re of i (mps/walls.c): cw, their centroid
+ * relative to i, and n, the unit normal into the fluid (from the centroid of the patch's
+ * dummy neighbours towards the wall layer).  Returns 0 (cw, n unset) when i has fewer than
+ * two wall or no dummy neighbours of the patch.  Used by the check of a particle through a
+ * wall and by the dummy particles' extrapolated velocity (dummyVelocity: extrapolate). */
+int lub_mps_wall_plane(const lub_mps *m, size_t i, unsigned patch, double cw[3], double n[3]);
+
+/* The dummy particles' velocity in the viscous term (system/schemes.yaml dummyVelocity; the
+ * derivation is at step.c, dummy_velocity).  The pair term of fluid particle i and dummy
+ * neighbour j is w_ij (u_g - u_i) = w_ij (f (U_j - u_i) + a) with the ghost velocity u_g:
+ * lub_mps_ghost returns f and sets a (3 components).  planes: the walls around i
+ * (lub_mps_ghost_planes, once per i); kappa: the no-slip profile's curvature at the wall,
+ * (G/rho - g)/nu with G the pressure gradient (NULL: none). */
+#define LUB_GHOST_PLANES 4
+typedef struct {
+    int n;                            /* patches among i's dummy neighbours (at most 4) */
+    unsigned patch[LUB_GHOST_PLANES]; /* their indices */
+    int ok[LUB_GHOST_PLANES];         /* lub_mps_wall_plane found the wall */
+    double c[LUB_GHOST_PLANES][3];    /* the wall layer's centroid relative to i */
+    double nrm[LUB_GHOST_PLANES][3];  /* its normal into the fluid */
+} lub_mps_ghost_planes;
+void lub_mps_ghost_planes_of(const lub_mps *m, size_t i, lub_mps_ghost_planes *g);
+double lub_mps_ghost(const lub_mps *m, size_t i, size_t j, const lub_mps_ghost_planes *g,
+                     const double kappa[3], double a[3]);
 
 /* Given particles (lub_mps.fixed: a multi-resolution level's fixed band, whose velocity is
  * interpolated from another level) are not computed and may drift into a curved wall with

@@ -72,7 +72,9 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
     m->cap = n;
     static const char *const gbar_names[3] = {"gradPx", "gradPy", "gradPz"};
     for (int d = 0; d < 3; d++)
-        m->gbar[d] = c->predictor > 0 && d < m->dim ? lub_particles_extra(P, gbar_names[d]) : NULL;
+        m->gbar[d] = (c->predictor > 0 || c->dummy_velocity == LUB_DUMMY_EXTRAPOLATE) && d < m->dim
+                         ? lub_particles_extra(P, gbar_names[d])
+                         : NULL;
     m->cav =
         c->clip_negative == LUB_NEGATIVE_CAVITATION ? lub_particles_extra(P, "cavitation") : NULL;
     m->surf = NULL;
@@ -86,6 +88,7 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
         m->bv[d] = alloc_doubles(n);
         m->xv[d] = alloc_doubles(n);
         m->grad[d] = alloc_doubles(n);
+        m->kap[d] = c->dummy_velocity == LUB_DUMMY_EXTRAPOLATE ? alloc_doubles(n) : NULL;
     }
     m->pnd = alloc_doubles(n);
     m->div = c->source == LUB_SOURCE_MIXED ? alloc_doubles(n) : NULL;
@@ -122,6 +125,7 @@ void lub_mps_free(lub_mps *m)
         free(m->bv[d]);
         free(m->xv[d]);
         free(m->grad[d]);
+        free(m->kap[d]);
     }
     free(m->pnd);
     free(m->div);
@@ -279,7 +283,20 @@ static void begin_rows(lub_mps *m, int nrows, int ncols, int nglobal)
  * image), not U; giving them U makes the wall partly slip (Poiseuille flow comes out with a
  * slip velocity of a few percent of u_max).  With `dummyVelocity: mirror` (default) a dummy
  * j seen from fluid particle i takes the ghost value 2 U_j - u_i, i.e. the pair term
- * w_ij (u_j - u_i) becomes 2 w_ij (U_j - u_i); `wall` keeps U_j. */
+ * w_ij (u_j - u_i) becomes 2 w_ij (U_j - u_i); `wall` keeps U_j.  The mirror continues the
+ * profile about i's own distance from the wall, not j's depth behind it: it is exact for a
+ * linear profile only where the two are equal, and leaves a slip, of second order in
+ * l0/H but large (plane Poiseuille flow four particles across, on the lattice rows: +9.7% in
+ * the flow rate, +2.5% at eight; with the wall's U, of first order: +28%, +13%).  `extrapolate`
+ * continues the no-slip profile through the wall (doc/methods.md §2.8, (2.8a)): with the wall's
+ * plane around i (lub_mps_wall_plane), i at the distance d_i in front of it, j at the depth d_j
+ * behind it, u_g = U_j - (d_j / d_i) (u_i - U_j) + (kappa_t / 2) d_j (d_i + d_j), the linear
+ * continuation (Morris, Fox and Zhu's ghost, [MFZ97]) plus the profile's curvature at the wall,
+ * which the momentum balance there gives: at a wall moving without acceleration, nu lap u = G/rho -
+ * g, kappa = (G/rho - g)/nu with G the smoothed running mean of the pressure gradient at i (the
+ * predictor's), its part along the wall (kappa_t).  The ghost is then exact for the quadratic
+ * profile of a lubricating film, and so is the Laplacian T-3 on the lattice rows
+ * (tests/unit/mps_flow_test.c, test_dummy_velocity). */
 /* Pressure gradient of the fluid particles (T-13 or T-15) from P->p at the current
  * positions; returns the number of LSMPS fallbacks. */
 static size_t pressure_gradient(lub_mps *m, double *const grad[3])
@@ -414,21 +431,34 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
      * smoothed over the fluid neighbours (m->grad is free until the gradient phase) */
     const double rinv = m->c.predictor > 0 ? 1.0 / m->c.rho : 0.0;
     double *const *gold = rinv != 0.0 ? m->grad : NULL;
-    if (gold) smooth_fluid(m, m->gbar, m->grad);
+    if (m->gbar[0]) smooth_fluid(m, m->gbar, m->grad);
+    /* dummyVelocity extrapolate: the curvature of the no-slip profile at the wall from the
+     * same smoothed running mean G of the pressure gradient, (G/rho - g)/nu (dummy_velocity) */
+    const int xtra = m->c.dummy_velocity == LUB_DUMMY_EXTRAPOLATE;
+    double *const *gcurv = xtra && m->gbar[0] ? m->grad : NULL;
+    const double rho_inv = 1.0 / m->c.rho, nu_inv = m->c.nu > 0 ? 1.0 / m->c.nu : 0.0;
     if (m->c.viscosity == LUB_VISCOSITY_EXPLICIT) {
         /* (T-3, T-7) with the dummy particles' ghost velocity (see dummy_velocity) */
         const double cl = lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, 1.0), nu = m->c.nu;
         const lub_neighbours *nb = &m->nb;
-        const double gm = m->c.mirror_dummies ? 2.0 : 1.0;
 #pragma omp parallel for schedule(static)
         for (size_t i = 0; i < n; i++) {
             if (P->kind[i] != LUB_FLUID || (fix && fix[i])) continue;
-            double acc[3] = {0, 0, 0};
+            double acc[3] = {0, 0, 0}, kap[3] = {0, 0, 0}, a[3];
+            lub_mps_ghost_planes gp;
+            if (xtra) lub_mps_ghost_planes_of(m, i, &gp);
+            if (gcurv)
+                for (int d = 0; d < dim; d++) kap[d] = (gcurv[d][i] * rho_inv - g[d]) * nu_inv;
+            if (m->kap[0])
+                for (int d = 0; d < dim; d++) m->kap[d][i] = kap[d];
             for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
                 double w = nb->w[q];
                 size_t j = nb->j[q];
-                double f = P->kind[j] == LUB_DUMMY ? gm : 1.0;
-                for (int d = 0; d < dim; d++) acc[d] += f * w * (P->u[d][j] - P->u[d][i]);
+                double f = 1.0;
+                a[0] = a[1] = a[2] = 0.0;
+                if (P->kind[j] == LUB_DUMMY)
+                    f = lub_mps_ghost(m, i, j, xtra ? &gp : NULL, gcurv ? kap : NULL, a);
+                for (int d = 0; d < dim; d++) acc[d] += w * (f * (P->u[d][j] - P->u[d][i]) + a[d]);
             }
             for (int d = 0; d < dim; d++)
                 m->us[d][i] += dt * (nu * cl * acc[d] + g[d] - (gold ? rinv * gold[d][i] : 0.0));
@@ -439,7 +469,6 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
          * symmetric since w_ij is. */
         const double k = lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, 0.5 * dt * m->c.nu);
         const lub_neighbours *nb = &m->nb;
-        const double gm = m->c.mirror_dummies ? 2.0 : 1.0;
         for (size_t i = 0; i < n; i++)
             m->row[i] = P->kind[i] == LUB_FLUID && !(fix && fix[i]) ? 0 : -1;
         int ncols, nglobal;
@@ -450,16 +479,27 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
             size_t i = (size_t)m->prow[r];
             int *col = lub_csr_row_col(&m->A, r);
             double *val = lub_csr_row_val(&m->A, r);
-            double wsum = 0, rhs[3] = {0, 0, 0};
+            double wsum = 0, rhs[3] = {0, 0, 0}, kap[3] = {0, 0, 0}, a[3];
             int e = 0, dg = -1; /* the diagonal in column order (the lists are sorted) */
+            lub_mps_ghost_planes gp;
+            if (xtra) lub_mps_ghost_planes_of(m, i, &gp);
+            if (gcurv)
+                for (int d = 0; d < dim; d++) kap[d] = (gcurv[d][i] * rho_inv - g[d]) * nu_inv;
+            if (m->kap[0])
+                for (int d = 0; d < dim; d++) m->kap[d][i] = kap[d];
             for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
                 double w = nb->w[q];
                 if (w <= 0) continue;
                 size_t j = nb->j[q];
-                /* a dummy's ghost velocity 2 U_j - u_i doubles its weight (dummy_velocity) */
-                double f = P->kind[j] == LUB_DUMMY ? gm : 1.0;
+                /* a dummy's ghost velocity (dummy_velocity): the pair term w (f (U_j - u_i)
+                 * + a), f = 2 for the mirror; a enters both halves of (T-31) */
+                double f = 1.0;
+                a[0] = a[1] = a[2] = 0.0;
+                if (P->kind[j] == LUB_DUMMY)
+                    f = lub_mps_ghost(m, i, j, xtra ? &gp : NULL, gcurv ? kap : NULL, a);
                 wsum += f * w;
-                for (int d = 0; d < dim; d++) rhs[d] += f * w * (P->u[d][j] - P->u[d][i]);
+                for (int d = 0; d < dim; d++)
+                    rhs[d] += f * w * (P->u[d][j] - P->u[d][i]) + 2.0 * w * a[d];
                 if (m->row[j] >= 0) {
                     if (dg < 0 && m->row[j] > r) dg = e++;
                     col[e] = m->row[j];
@@ -1244,8 +1284,9 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
             x[i] += (u[i] - us[i]) * dt;
         }
     }
-    if (m->c.predictor > 0) {
-        const double a = m->c.predictor;
+    if (m->gbar[0]) {
+        /* the running mean (dummyVelocity extrapolate without the predictor: weight 0.1) */
+        const double a = m->c.predictor > 0 ? m->c.predictor : 0.1;
         for (int d = 0; d < dim; d++) {
             double *gb = m->gbar[d];
             const double *gr = m->grad[d];

@@ -76,18 +76,17 @@ static const char *kind_name(int k)
 #define THROUGH_GATE  1.2  /* l0: fluid particles this close to a dummy particle are tested */
 #define THROUGH_DEPTH 0.25 /* l0: t0 <= THROUGH_DEPTH < t1; also the both-sides margin */
 
-/* Fluid particle i and the wall of patch `patch`: the depths t0, t1 (m) and whether i went
- * through the wall layer in the step (dt). */
-static int through(const lub_mps *m, double dt, size_t i, unsigned patch, double *t0, double *t1)
+int lub_mps_wall_plane(const lub_mps *m, size_t i, unsigned patch, double cw[3], double n[3])
 {
     const lub_particles *P = m->P;
     const lub_neighbours *nb = &m->nb;
     double *const x[3] = {P->x[0], P->x[1], P->x[2]};
     const int dim = m->dim;
-    const double re2 = m->re * m->re, l0 = m->l0;
+    const double re2 = m->re * m->re;
     /* centroids of the patch's wall and dummy neighbours, covariance of the wall particles */
-    double cw[3] = {0, 0, 0}, cd[3] = {0, 0, 0}, S[3][3] = {{0}};
+    double cd[3] = {0, 0, 0}, S[3][3] = {{0}};
     int nw = 0, nd = 0;
+    for (int a = 0; a < 3; a++) cw[a] = n[a] = 0;
     for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
         const size_t j = nb->j[q];
         if (P->kind[j] == LUB_FLUID || P->patch[j] != patch) continue;
@@ -105,7 +104,7 @@ static int through(const lub_mps *m, double dt, size_t i, unsigned patch, double
         }
     }
     if (nw < 2 || !nd) return 0;
-    double n0[3], C[3][3], A[3][3] = {{0}}, n[3] = {0, 0, 0}, nn = 0, n0n = 0, tr = 0;
+    double n0[3], C[3][3], A[3][3] = {{0}}, nn = 0, n0n = 0, tr = 0;
     for (int a = 0; a < 3; a++) {
         cw[a] /= nw;
         n0[a] = cw[a] - cd[a] / nd;
@@ -139,6 +138,20 @@ static int through(const lub_mps *m, double dt, size_t i, unsigned patch, double
     if (!(nn > 0)) return 0;
     const double sn = (n[0] * n0[0] + n[1] * n0[1] + n[2] * n0[2] < 0 ? -1 : 1) / sqrt(nn);
     for (int a = 0; a < 3; a++) n[a] *= sn;
+    return 1;
+}
+
+/* Fluid particle i and the wall of patch `patch`: the depths t0, t1 (m) and whether i went
+ * through the wall layer in the step (dt). */
+static int through(const lub_mps *m, double dt, size_t i, unsigned patch, double *t0, double *t1)
+{
+    const lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    double *const x[3] = {P->x[0], P->x[1], P->x[2]};
+    const int dim = m->dim;
+    const double re2 = m->re * m->re, l0 = m->l0;
+    double cw[3], n[3];
+    if (!lub_mps_wall_plane(m, i, patch, cw, n)) return 0;
     /* tangent directions e[0] (2-D); e[0], e[1] (3-D: e[0] = n x the axis least aligned
      * with n, e[1] = n x e[0]) */
     double e[2][3] = {{-n[1], n[0], 0}, {0, 0, 0}};
@@ -317,4 +330,53 @@ double lub_mps_max_speed(const lub_mps *m)
         if (s > u2) u2 = s;
     }
     return m->par ? lub_par_max(sqrt(u2)) : sqrt(u2); /* several ranks: of all */
+}
+
+void lub_mps_ghost_planes_of(const lub_mps *m, size_t i, lub_mps_ghost_planes *g)
+{
+    const lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    g->n = 0;
+    for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+        const size_t j = nb->j[q];
+        if (P->kind[j] != LUB_DUMMY || nb->w[q] <= 0) continue;
+        const unsigned p = P->patch[j];
+        int k = 0;
+        while (k < g->n && g->patch[k] != p) k++;
+        if (k < g->n || g->n == LUB_GHOST_PLANES) continue;
+        g->patch[k] = p;
+        g->ok[k] = lub_mps_wall_plane(m, i, p, g->c[k], g->nrm[k]);
+        g->n++;
+    }
+}
+
+/* The closest a fluid particle is taken to be to the wall in the extrapolation (l0): the ratio
+ * d_j / d_i stays bounded for a particle pressed against the wall layer */
+#define GHOST_MIN_DEPTH 0.5
+
+double lub_mps_ghost(const lub_mps *m, size_t i, size_t j, const lub_mps_ghost_planes *g,
+                     const double kappa[3], double a[3])
+{
+    a[0] = a[1] = a[2] = 0.0;
+    if (m->c.dummy_velocity == LUB_DUMMY_WALL) return 1.0;
+    if (m->c.dummy_velocity == LUB_DUMMY_MIRROR || !g) return 2.0;
+    const lub_particles *P = m->P;
+    int k = 0;
+    while (k < g->n && g->patch[k] != P->patch[j]) k++;
+    if (k == g->n || !g->ok[k]) return 2.0; /* no wall layer to measure from: the mirror */
+    const double *c = g->c[k], *n = g->nrm[k];
+    double *const x[3] = {P->x[0], P->x[1], P->x[2]};
+    double v[3];
+    lub_neighbours_r(&m->nb, x, i, j, v);
+    /* depths along n: i in front of the wall layer, j behind it */
+    double di = 0.0, dj = 0.0;
+    for (int d = 0; d < m->dim; d++) di -= n[d] * c[d], dj += n[d] * (c[d] - v[d]);
+    if (!(dj > 0.0)) return 2.0;
+    if (di < GHOST_MIN_DEPTH * m->l0) di = GHOST_MIN_DEPTH * m->l0;
+    if (kappa) {
+        double kn = 0.0;
+        for (int d = 0; d < m->dim; d++) kn += kappa[d] * n[d];
+        for (int d = 0; d < m->dim; d++) a[d] = 0.5 * (kappa[d] - kn * n[d]) * dj * (di + dj);
+    }
+    return 1.0 + dj / di;
 }

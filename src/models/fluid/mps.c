@@ -85,7 +85,8 @@ static void mps_log(const lub_mps *m, double dt, double pit, char *buf, size_t s
  *
  * Viscosity: the reaction of the Laplacian terms (T-3) between each fluid particle i and
  * the patch's wall and dummy particles j, rho l0^d nu (2d / (lambda0 n0)) f_j w_ij (u_j -
- * u*_i), f_j = 2 for a dummy with mirrored velocity (the ghost 2 U - u_i), else 1: the
+ * u*_i), f_j = 2 for a dummy with mirrored velocity (the ghost 2 U - u_i), else 1 (with
+ * dummyVelocity extrapolate the ghost's pair term f (U_j - u*_i) + a of lub_mps_ghost): the
  * Laplacian's pair terms are antisymmetric, so the viscous momentum the fluid gains the body
  * loses.  u*_i is the velocity after the viscous step (the implicit half of T-31; the
  * explicit scheme took u^k, a difference of O(dt)), u_j the body particle's velocity of the
@@ -127,14 +128,24 @@ static void mps_wall_forces(const lub_mps *m, int patch, double *const area[3],
     double dv = m->c.rho;
     for (int d = 0; d < dim; d++) dv *= m->l0;
     const double k = dv * lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, m->c.nu);
-    const double gm = m->c.mirror_dummies ? 2.0 : 1.0;
+    const int xtra = m->c.dummy_velocity == LUB_DUMMY_EXTRAPOLATE;
     for (size_t i = 0; i < n; i++) {
         if (P->kind[i] != LUB_FLUID) continue;
+        lub_mps_ghost_planes gp;
+        int planes = 0;
+        double kap[3] = {0, 0, 0};
+        if (m->kap[0])
+            for (int d = 0; d < dim; d++) kap[d] = m->kap[d][i];
         for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
             const size_t j = nb->j[q];
             if (nb->w[q] <= 0 || P->kind[j] == LUB_FLUID || P->patch[j] != patch) continue;
-            const double c = k * nb->w[q] * (P->kind[j] == LUB_DUMMY ? gm : 1.0);
-            for (int d = 0; d < dim; d++) f[d][j] -= c * (P->u[d][j] - m->us[d][i]);
+            double fg = 1.0, a[3] = {0, 0, 0};
+            if (P->kind[j] == LUB_DUMMY) {
+                if (xtra && !planes) lub_mps_ghost_planes_of(m, i, &gp), planes = 1;
+                fg = lub_mps_ghost(m, i, j, xtra ? &gp : NULL, m->kap[0] ? kap : NULL, a);
+            }
+            const double c = k * nb->w[q];
+            for (int d = 0; d < dim; d++) f[d][j] -= c * (fg * (P->u[d][j] - m->us[d][i]) + a[d]);
         }
     }
 }
