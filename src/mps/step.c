@@ -286,8 +286,8 @@ static void begin_rows(lub_mps *m, int nrows, int ncols, int nglobal)
  * w_ij (u_j - u_i) becomes 2 w_ij (U_j - u_i); `wall` keeps U_j.  The mirror continues the
  * profile about i's own distance from the wall, not j's depth behind it: it is exact for a
  * linear profile only where the two are equal, and leaves a slip, of second order in
- * l0/H but large (plane Poiseuille flow four particles across, on the lattice rows: +9.7% in
- * the flow rate, +2.5% at eight; with the wall's U, of first order: +28%, +13%).  `extrapolate`
+ * l0/H but large (plane Poiseuille flow four particles across, on the lattice rows: +8.3% in
+ * the flow rate, +2.2% at eight; with the wall's U, of first order: +24%, +11%).  `extrapolate`
  * continues the no-slip profile through the wall (doc/methods.md §2.8, (2.8a)): with the wall's
  * plane around i (lub_mps_wall_plane), i at the distance d_i in front of it, j at the depth d_j
  * behind it, u_g = U_j - (d_j / d_i) (u_i - U_j) + (kappa_t / 2) d_j (d_i + d_j), the linear

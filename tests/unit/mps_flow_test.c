@@ -722,7 +722,7 @@ static void test_compression(void)
  * layers.  Extrapolated (the no-slip profile continued behind the wall with its slope and the
  * curvature (G/rho - g)/nu of the momentum balance at the wall), the MPS Laplacian is exact
  * for the parabola on the lattice rows; the mirror 2 U - u_i is exact for a linear profile
- * only and leaves about 10% (doc/methods.md §2.8 gives the rows' model: 9.7% at H = 4 l0).
+ * only and leaves about 8% (doc/methods.md §2.8 gives the rows' model: 8.3% at H = 4 l0).
  * The rows shear past each other in the flow, which the lattice model leaves out: the
  * extrapolated run is held to 1%. */
 static double narrow_poiseuille(int dummy)
