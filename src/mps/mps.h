@@ -116,6 +116,9 @@ typedef struct {
     int patch_moved[LUB_MAX_PATCHES]; /* 1: a model sets the velocity of the patch's wall and
                                          dummy particles before each step (elasticWall, a
                                          movingWalls motion history) */
+    int patch_rigid[LUB_MAX_PATCHES]; /* 1: the patch is a rigid body that may turn
+                                         (rigidBodies): the walls' own quantities of
+                                         surfaceTension follow it every step */
 
     /* set by a model that drives the solvers (multiResolution), not read from a dictionary */
     int fixed_flags; /* allocate lub_mps.fixed: particles whose velocity and pressure are given */

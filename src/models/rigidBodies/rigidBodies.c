@@ -352,6 +352,7 @@ static void rigid_configure(lub_model *m, lub_scene *s, lub_mps_config *c)
 {
     rigid *r = m->state;
     for (int k = 0; k < r->n; k++) c->patch_moved[r->body[k].patch] = 1;
+    for (int k = 0; k < r->n; k++) c->patch_rigid[r->body[k].patch] = 1;
     const double delta = s->fluid->body_shell * s->P->levels[0].l0;
     if (!(delta > 0)) return;
     for (int k = 0; k < r->n; k++) {
