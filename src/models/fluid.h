@@ -55,13 +55,6 @@ typedef struct lub_fluid_type {
      * (K-8)) may ignore them.  NULL: the formulation cannot move bodies. */
     void (*wall_forces)(const lub_mps *m, int patch, double *const area[3], const double omega[3],
                         double *const f[3]);
-    /* Where wall_forces acts, in l0 outside a body's wall layer: 0 where it takes the wall
-     * particles' pressure over the body's own surface (mps), 1/2 for pair forces across the
-     * gap between the wall layer and the fluid's first row (mph: the fluid's particles stand
-     * for the volume from l0/2 outside the wall layer on, so hydrostatics pushes on that
-     * surface).  A body carries the fluid of that shell, which no particle represents
-     * (rigidBodies, methods.md §7.2). */
-    double body_shell;
 } lub_fluid_type;
 
 /* The formulations, NULL-terminated, the default first. */

@@ -798,5 +798,4 @@ const lub_fluid_type lub_fluid_mph = {
     .check = mph_check,
     .log = mph_log,
     .wall_forces = mph_wall_forces,
-    .body_shell = 0.5,
 };

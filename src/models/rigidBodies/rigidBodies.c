@@ -35,11 +35,6 @@
  *
  *     F = sum_{i in patch} f_i,   T = sum_{i in patch} (x_i - x_G) x f_i.
  *
- * With mph the pair forces act on the surface l0/2 outside the wall layer, where the fluid's
- * particles begin to stand for volume; a circle or sphere carries the shell of fluid from R
- * to R + l0/2 (shell(): its mass and inertia in the body's, its weight added to F, so that F
- * is the force on the body proper at rest: Archimedes with the body's own volume).
- *
  * The offsets x0 - x_G0 (body frame) are the particle fields rigidX0, rigidY0 (rigidZ0),
  * so that they travel with the particles and their files; the body's state (x_G, q or theta,
  * V, omega, the fluid's F and T of the last step, the contacts' tangential springs) is its
@@ -89,9 +84,7 @@ typedef struct {
     double ds; /* circle, sphere: the surface per wall particle */
     lub_body b;
     lub_body_state s;
-    double F[3], T[3];        /* the fluid's force and torque of the last step (world) */
-    double shell, shell_mass; /* the fluid shell it carries (rigid_configure): thickness [m],
-                                 mass [kg; kg/m in 2-D] */
+    double F[3], T[3]; /* the fluid's force and torque of the last step (world) */
     lub_node *contact_node;
     int nwall; /* wall particles of the patch */
     FILE *table;
@@ -322,47 +315,12 @@ static void rigid_check(lub_model *m, lub_scene *s)
                        s->fluid->name);
 }
 
-/* The shell of fluid a circle or sphere carries (methods.md §7.2): the formulation's force
- * acts body_shell l0 outside the wall layer (models/fluid.h), and the fluid between the body's
- * surface R and R + delta, which no particle stands for, moves with the body (no slip).  Body
- * and shell are one rigid composite of volume V(R + delta) whose buoyancy the fluid gives;
- * the shell's mass and inertia are added to the body's, its weight to the force reported as
- * the fluid's (rigid_after_step), so that a held body feels rho_f g V of its own volume and a
- * body as dense as the fluid floats.  Counted whole, immersed or not; a polygon has none. */
-static void shell(rigid_body *rb, double rho_f, double delta)
-{
-    const double R = rb->b.radius, Ro = R + delta;
-    lub_body *b = &rb->b;
-    rb->shell = delta;
-    if (rb->shape == SHAPE_CIRCLE) {
-        rb->shell_mass = rho_f * M_PI * (Ro * Ro - R * R);
-        b->inertia[2] += 0.5 * rho_f * M_PI * (Ro * Ro * Ro * Ro - R * R * R * R);
-    } else if (rb->shape == SHAPE_SPHERE) {
-        rb->shell_mass = rho_f * 4.0 / 3.0 * M_PI * (Ro * Ro * Ro - R * R * R);
-        const double I = 0.4 * rho_f * 4.0 / 3.0 * M_PI * (pow(Ro, 5) - pow(R, 5));
-        for (int d = 0; d < 3; d++) b->inertia[d] += I;
-    } else {
-        rb->shell = 0.0;
-        return;
-    }
-    b->mass += rb->shell_mass;
-}
-
 static void rigid_configure(lub_model *m, lub_scene *s, lub_mps_config *c)
 {
-    rigid *r = m->state;
+    (void)s;
+    const rigid *r = m->state;
     for (int k = 0; k < r->n; k++) c->patch_moved[r->body[k].patch] = 1;
     for (int k = 0; k < r->n; k++) c->patch_rigid[r->body[k].patch] = 1;
-    const double delta = s->fluid->body_shell * s->P->levels[0].l0;
-    if (!(delta > 0)) return;
-    for (int k = 0; k < r->n; k++) {
-        shell(&r->body[k], c->rho, delta);
-        if (r->body[k].contact_node) lub_body_contact_damping(&r->body[k].b, r->zeta[k]);
-    }
-    lub_body b[MAX_BODIES];
-    for (int k = 0; k < r->n; k++) b[k] = r->body[k].b;
-    for (int q = 0; q < r->npairs; q++)
-        lub_body_pair_damping(&r->pair[q], b, r->zeta[r->pair[q].a]);
 }
 
 /* the body-frame offset of particle i into r0, its world offset R r0 into r */
@@ -542,8 +500,7 @@ static lub_step_status rigid_before_step(lub_model *m, lub_scene *s, double t, d
     double F[MAX_BODIES][3], T[MAX_BODIES][3];
     for (int k = 0; k < r->n; k++) {
         b[k] = r->body[k].b, st[k] = r->body[k].s;
-        /* the body's mass holds its shell's, whose weight the reported force holds too */
-        for (int d = 0; d < 3; d++) F[k][d] = r->body[k].F[d] - r->body[k].shell_mass * b[k].g[d];
+        memcpy(F[k], r->body[k].F, sizeof F[k]);
         memcpy(T[k], r->body[k].T, sizeof T[k]);
     }
     lub_bodies_step(r->n, b, st, (const double(*)[3])F, (const double(*)[3])T, r->npairs, r->pair,
@@ -606,8 +563,7 @@ static void rigid_after_step(lub_model *m, lub_scene *s, double t)
                 P->u[d][i] = u[d];
             }
         }
-        /* the force on the body without its shell's weight (rigid_configure: shell) */
-        for (int d = 0; d < 3; d++) rb->F[d] = F[d] + rb->shell_mass * rb->b.g[d];
+        memcpy(rb->F, F, sizeof F);
         memcpy(rb->T, T, sizeof T);
     }
 }
@@ -646,10 +602,6 @@ static void rigid_header(const lub_model *m, const lub_scene *s)
                         rb->name, shape[rb->shape], s->P->patch_names[rb->patch], rb->density,
                         b->mass, b->inertia[0], b->inertia[1], b->inertia[2], rb->s.x[0],
                         rb->s.x[1], rb->s.x[2], rb->nwall, hold[0] ? "; held:" : "", hold);
-        if (rb->shell > 0)
-            lub_message("rigidBodies: %s: carries the fluid shell from R to R + %g m (the "
-                        "fluid's first cells; methods.md 7.2): %.6g %s in M and I above",
-                        rb->name, rb->shell, rb->shell_mass, dim == 2 ? "kg/m" : "kg");
         if (b->nplanes)
             lub_message("rigidBodies: %s: contact with %d plane(s): k_n %g, k_t %g, c_n %g, c_t "
                         "%g, friction %g, distance %g m; dt <= %g s (%g steps per period)",
