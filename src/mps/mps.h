@@ -111,12 +111,17 @@ typedef struct {
     double g[3];   /* without models; the models of a scene add theirs: hooks.forces) */
     int viscosity; /* LUB_VISCOSITY_* */
     double bulk_viscosity, bulk_modulus; /* MPH lambda [Pa s], kappa [Pa] (models/fluid/mph.c) */
+    int viscous_layers; /* MPH: the viscous coefficient 2 (d+2) over lub_mph_layer_quadrature
+                           (viscousNormalisation: layers; 0: the continuum's) */
     double patch_velocity[LUB_MAX_PATCHES][3]; /* wall velocities (movingWalls); on a patch
                                                   a model moves: a velocity of its largest
                                                   speed (lubFoam's Courant number), or 0 */
     int patch_moved[LUB_MAX_PATCHES]; /* 1: a model sets the velocity of the patch's wall and
                                          dummy particles before each step (elasticWall, a
                                          movingWalls motion history) */
+    int patch_rigid[LUB_MAX_PATCHES]; /* 1: the patch is a rigid body that may turn
+                                         (rigidBodies): the walls' own quantities of
+                                         surfaceTension follow it every step */
 
     /* set by a model that drives the solvers (multiResolution), not read from a dictionary */
     int fixed_flags; /* allocate lub_mps.fixed: particles whose velocity and pressure are given */

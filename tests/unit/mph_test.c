@@ -245,6 +245,43 @@ static void test_operators_3d(void)
     operators(3);
 }
 
+/* The viscous term of the shear u_x = n^2 across layers of particles l0 apart (n the layers'
+ * normal: y in 2-D, z in 3-D), the particles of each layer on a lattice shifted within the
+ * layer by an offset s: averaged over s (a midpoint grid of N offsets per direction), the sum
+ * over a layer tends to its integral, and the average response over the continuum's 2 to
+ * lub_mph_layer_quadrature (0.9603 in 2-D), by which viscousNormalisation: layers divides
+ * (methods.md §8, Accuracy; tests/cases/rigidBodiesMph's circular Couette flow on rings) */
+static double layer_response(int dim, int N)
+{
+    const int kz = dim == 3 ? 5 : 0;
+    double sum = 0;
+    for (int p = 0; p < N; p++)
+        for (int q = 0; q < (dim == 3 ? N : 1); q++) {
+            const double s[2] = {(p + 0.5) / N, (q + 0.5) / N};
+            for (int k = -4; k <= 4; k++) /* the layer n = k */
+                for (int a = -5; a <= 5; a++)
+                    for (int b = -kz; b <= kz; b++) {
+                        const double x = a + s[0], y = dim == 3 ? b + s[1] : 0.0;
+                        const double r = sqrt(x * x + y * y + k * k);
+                        const double ue = k * k * x / r; /* (u_j - u_i).e, u_x = n^2 */
+                        sum += -2.0 * (dim + 2) * ue * (x / r) * kdw(dim, 3.5, r) / r;
+                    }
+        }
+    return sum / (dim == 3 ? N * N : N) / 2.0;
+}
+
+static void test_layer_quadrature(void)
+{
+    for (int dim = 2; dim <= 3; dim++) {
+        const double q = lub_mph_layer_quadrature(dim),
+                     a = layer_response(dim, dim == 2 ? 400 : 60);
+        printf("  %d-D: shear across layers %.6f of the continuum's (offsets averaged here), "
+               "lub_mph_layer_quadrature %.6f\n",
+               dim, a, q);
+        CHECK_NEAR(a, q, 2e-4);
+    }
+}
+
 /* ---- one step against the discrete equations, formed here over all pairs --------------- */
 
 static unsigned long long rng_state = 88172645463325252ull;
@@ -722,6 +759,7 @@ int main(void)
     RUN(test_elastic_limit);
     RUN(test_operators_2d);
     RUN(test_operators_3d);
+    RUN(test_layer_quadrature);
     RUN(test_step_equations);
     RUN(test_rotating_drop);
     RUN(test_hydrostatic);

@@ -110,12 +110,33 @@ double lub_mph_elastic_limit(int dim)
     return 2.0 / amax;
 }
 
+double lub_mph_layer_quadrature(int dim)
+{
+    /* l0 = 1, the layers n = +-k (k = 1, 2, 3: the layer n = 0 has e_n = 0), t the distance
+     * within a layer from the foot of the normal: 2-D int dt over the line, 3-D int 2 pi t dt
+     * over the plane with e_t^2 averaged over the azimuth (1/2).  Midpoint rule: w_v' is
+     * continuous and vanishes at h_v, so 2e4 points per layer give 1e-8. */
+    const double h = LUB_MPH_HV;
+    const int nq = 20000;
+    double s = 0;
+    for (int k = 1; k < h; k++) {
+        const double tmax = sqrt(h * h - (double)(k * k)), dt = tmax / nq;
+        for (int q = 0; q < nq; q++) {
+            const double t = (q + 0.5) * dt, r2 = t * t + (double)(k * k), r = sqrt(r2);
+            const double f = -lub_mph_dw(dim, 1.0, h, r) * r * t * t * (double)(k * k) / (r2 * r2);
+            s += 2.0 * (dim == 2 ? 2.0 * f : M_PI * t * f) * dt; /* 2: the layers +-k */
+        }
+    }
+    return (dim + 2) * s;
+}
+
 /* ---- the formulation's state ------------------------------------------------------------ */
 
 typedef struct {
     size_t cap;    /* particles the arrays hold (lub_mps.cap) */
     double hp, hv; /* kernel radii [m] */
     double n0;
+    double vscale;     /* the viscous coefficient over the continuum's 2 (d+2) (viscous_layers) */
     double *pk;        /* P^kap_i */
     double *s;         /* s_i = sum_j u_ij.g_ij */
     double *G[3];      /* sum_j g_ij */
@@ -153,6 +174,7 @@ static mph_state *state(lub_mps *m)
     S->hp = LUB_MPH_HP * m->l0;
     S->hv = LUB_MPH_HV * m->l0;
     S->n0 = lub_mph_n0(m->dim, m->l0);
+    S->vscale = m->c.viscous_layers ? 1.0 / lub_mph_layer_quadrature(m->dim) : 1.0;
     S->pk = lub_calloc(n, sizeof(double));
     S->s = lub_calloc(n, sizeof(double));
     for (int d = 0; d < 3; d++) S->G[d] = lub_calloc(n, sizeof(double));
@@ -274,7 +296,7 @@ static int assemble(lub_mps *m, mph_state *S, double dt)
         S->blkp = lub_malloc(S->blk_cap * sizeof *S->blkp);
         S->blk = lub_malloc(S->blk_cap * 9 * sizeof *S->blk);
     }
-    const double visc = -2.0 * mu * (dim + 2);
+    const double visc = -2.0 * mu * (dim + 2) * S->vscale;
     for (int r = 0; r < nf; r++) {
         const size_t a = (size_t)m->prow[r];
         int nk = 0;
@@ -544,7 +566,8 @@ void lub_mph_operators(lub_mps *m, double *pnd, double *div, double *const visc[
             const size_t j = nb->j[q];
             double ue = 0;
             for (int d = 0; d < dim; d++) ue += (P->u[d][j] - P->u[d][i]) * e[d];
-            const double f = -2.0 * (dim + 2) * ue * lub_mph_dw(dim, m->l0, S->hv, r) / r;
+            const double f =
+                -2.0 * (dim + 2) * S->vscale * ue * lub_mph_dw(dim, m->l0, S->hv, r) / r;
             for (int d = 0; d < dim; d++) v[d] += f * e[d];
         }
         for (int d = 0; d < dim; d++) visc[d][i] = v[d];
@@ -615,7 +638,8 @@ static void mph_wall_forces(const lub_mps *m, int patch, double *const area[3],
     const mph_state *S = m->fstate;
     const int dim = m->dim;
     const double dV = dim == 2 ? m->l0 * m->l0 : m->l0 * m->l0 * m->l0;
-    const double visc = -2.0 * m->c.rho * m->c.nu * (dim + 2), mass = m->c.rho * dV;
+    const double visc = -2.0 * m->c.rho * m->c.nu * (dim + 2) * (S ? S->vscale : 1.0);
+    const double mass = m->c.rho * dV;
     for (size_t b = 0; b < P->n; b++) {
         for (int d = 0; d < 3; d++) f[d][b] = 0.0;
         if (P->kind[b] == LUB_FLUID || P->patch[b] != patch || !S) continue;
@@ -647,6 +671,11 @@ static void mph_read(lub_mps_config *c, const lub_case *cs, lub_node *models, lu
     /* fluid: { type: mph } is there (the type was read from it) */
     c->bulk_viscosity = lub_dict_real(entry, "bulkViscosity", LUB_NONNEGATIVE);
     c->bulk_modulus = lub_dict_real(entry, "bulkModulus", LUB_POSITIVE);
+    /* the viscous coefficient 2 (d+2) is the continuum's; on layers of particles l0 apart
+     * (fluidLayers on a body) a shear across them gets lub_mph_layer_quadrature of it (0.96
+     * in 2-D): 'layers' divides by that (methods.md §8, Accuracy) */
+    static const char *const norms[] = {"continuum", "layers", NULL};
+    c->viscous_layers = lub_dict_choice(entry, "viscousNormalisation", norms, 0) == 1;
     lub_node *v = lub_dict_find(models, "viscosity");
     if (v)
         lub_node_error(v, "'viscosity' belongs to the fluid 'mps'; the fluid 'mph' takes its "
@@ -672,6 +701,10 @@ static void mph_header_level(const lub_mps *m)
                 "mu %g Pa s, bulkViscosity lambda %g Pa s, bulkModulus kappa %g Pa",
                 m->l0, LUB_MPH_HP * m->l0, LUB_MPH_HV * m->l0, lub_mph_n0(m->dim, m->l0), m->c.rho,
                 m->c.rho * m->c.nu, m->c.bulk_viscosity, m->c.bulk_modulus);
+    if (m->c.viscous_layers)
+        lub_message("MPH: viscousNormalisation layers: the viscous coefficient 2 (d+2) over "
+                    "%.6f, its response to a shear across layers l0 apart",
+                    lub_mph_layer_quadrature(m->dim));
 }
 
 static void mph_header(const lub_mps *m)

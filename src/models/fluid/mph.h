@@ -42,6 +42,12 @@ double lub_mph_n0(int dim, double l0);
  * max_k |a(k)|), a(k) = sum_j w_p'(r_j) e_j (exp(i k.r_j) - 1) over the lattice: the
  * symplectic Euler step of the stiffest lattice compression wave (omega dt < 2). */
 double lub_mph_elastic_limit(int dim);
+/* The viscous term's response to a shear across layers of particles l0 apart, the particles
+ * spread evenly within each layer (body-fitted rows: particleGen's fluidLayers), over the
+ * continuum's: (d+2) sum_k int (-w_v'(r) r) e_t^2 e_n^2 over the layers n = k l0, the kernel
+ * normalised as l0^-d int w dV = 1.  0.9603 in 2-D (methods.md §8, Accuracy).
+ * viscousNormalisation: layers divides the viscous coefficient by it. */
+double lub_mph_layer_quadrature(int dim);
 
 /* One MPH-I step of dt (the fluid's step, models/fluid.h). */
 lub_step_status lub_mph_step(lub_mps *m, double dt, long *bad, char *msg, size_t msgsize);

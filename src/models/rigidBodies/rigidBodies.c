@@ -320,6 +320,7 @@ static void rigid_configure(lub_model *m, lub_scene *s, lub_mps_config *c)
     (void)s;
     const rigid *r = m->state;
     for (int k = 0; k < r->n; k++) c->patch_moved[r->body[k].patch] = 1;
+    for (int k = 0; k < r->n; k++) c->patch_rigid[r->body[k].patch] = 1;
 }
 
 /* the body-frame offset of particle i into r0, its world offset R r0 into r */

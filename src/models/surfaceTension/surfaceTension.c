@@ -25,7 +25,9 @@
  * wetting; c = 0: sigma_SL = 2 sigma, theta = 180 degrees); without it the wall could only
  * add energy and every angle would be 90 degrees or more.  The walls' own part of n^a and
  * chi (their wall and dummy neighbours) is formed once, at the first step, and kept: walls
- * at rest or translating rigidly (not an elastic wall).  Kernels: w^a = (r/h)(1 -
+ * at rest or translating rigidly (not an elastic wall); with a rigid body (mps.h
+ * patch_rigid, the fluid mph) every step, and the walls' own pairs give the wall particles
+ * their force too, so that a body turns with its wetting.  Kernels: w^a = (r/h)(1 -
  * r/h)^2 / (S_a h^d), S_a = pi/(15 l0^d); w^g the MPH kernel (models/fluid/mph.h);
  * h = h_s = 3.5 l0; R2 = h^2/10 (2-D), 2 h^2/21 (3-D); k = 0.350778153 (2-D), 0.326976006
  * (3-D); a = sigma / (h_s (I_N + k^2 I_X)), I_N = 0.024679383, I_X = 0.226126699 (2-D),
@@ -171,6 +173,14 @@ static void st_check(lub_model *m, lub_scene *s)
                     "pressure does not build; a 2-D drop contracts until it has no surface "
                     "particle left (methods.md 9).  The fluid 'mph' carries it",
                     s->models_path);
+    lub_node *rb = lub_dict_find(lub_dict_root(s->dict), "rigidBodies");
+    if (rb && strcmp(s->fluid->name, "mph") != 0)
+        lub_node_error(rb,
+                       "surfaceTension with rigidBodies needs the fluid 'mph' (fluid: { type: "
+                       "mph, ... }): the fluid '%s' gives a body no share of the surface "
+                       "tension, and its walls' own part of the potential would not turn "
+                       "with the body",
+                       s->fluid->name);
     if (s->P->nlevels > 1 || lub_dict_find(lub_dict_root(s->dict), "multiResolution"))
         lub_node_error(m->entry, "surfaceTension: one resolution level only (not with "
                                  "multiResolution)");
@@ -266,18 +276,36 @@ static int st_particle_forces(lub_model *m, const lub_mps *f, double *const acc[
     const double l0 = S->l0, hs = S->hs;
     if (P->n > S->cap) lub_bug("surfaceTension: %zu particles, %zu allocated", P->n, S->cap);
     if (S->sigma == 0) return 0;
-    if (!S->walls_done) walls_own(S, f);
+    /* a rigid body (rigidBodies, with mph: st_check) turns: the walls' own part is formed
+     * afresh every step from the step's lists, which hold every particle's (mph) */
+    int rigid = 0;
+    for (int p = 0; p < P->npatches; p++) rigid |= f->c.patch_rigid[p];
+    if (!rigid && !S->walls_done) walls_own(S, f);
     const double ch = hs / S->R2;
     /* n^a and chi: the walls' own part, then every fluid particle's pairs (its own sums, and
      * its share of its wall neighbours', c w) */
     for (size_t i = 0; i < P->n; i++) {
         const int fl = P->kind[i] == LUB_FLUID;
         const uint64_t id = P->id[i];
-        if (!fl && id >= S->nid)
+        for (int d = 0; d < 3; d++) S->chi[d][i] = 0.0;
+        S->na[i] = 0.0;
+        if (fl) continue;
+        if (rigid) {
+            for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+                double e[3];
+                const double r = pair(nb, q, dim, e);
+                if (!(r < hs) || r == 0 || P->kind[nb->j[q]] == LUB_FLUID) continue;
+                S->na[i] += wa(dim, l0, hs, r);
+                const double wg = lub_mph_w(dim, l0, hs, r);
+                for (int d = 0; d < dim; d++) S->chi[d][i] += nb->dx[d][q] * wg;
+            }
+            continue;
+        }
+        if (id >= S->nid)
             lub_bug("surfaceTension: wall particle id %llu, %zu kept", (unsigned long long)id,
                     S->nid);
-        S->na[i] = fl ? 0.0 : S->naw[id];
-        for (int d = 0; d < 3; d++) S->chi[d][i] = fl || d >= dim ? 0.0 : S->chiw[d][id];
+        S->na[i] = S->naw[id];
+        for (int d = 0; d < dim; d++) S->chi[d][i] = S->chiw[d][id];
     }
     for (size_t i = 0; i < P->n; i++) {
         if (P->kind[i] != LUB_FLUID) continue;
@@ -332,6 +360,30 @@ static int st_particle_forces(lub_model *m, const lub_mps *f, double *const acc[
                  * wall_forces); the step adds the accelerations to fluid particles only */
                 if (wall) acc[d][j] -= fd * dA * inv_m;
             }
+        }
+        for (int d = 0; d < dim; d++) acc[d][a] += F[d] * dA * inv_m;
+    }
+    /* with a rigid body: the force of the walls' own pairs (c = 1) on each wall particle, the
+     * same -dV/dx_a, so that a body gets all of it: its particles' pairs with one another
+     * sum to no force but, the DGP term being non-central, to the torque of the cross terms
+     * chi_own.chi_fluid of |chi|^2, which turn with the body (tests/cases/rigidBodiesMph:
+     * fluid + body conserve angular momentum to round-off) */
+    for (size_t a = 0; rigid && a < P->n; a++) {
+        if (P->kind[a] == LUB_FLUID) continue;
+        double F[3] = {0, 0, 0};
+        for (size_t q = nb->start[a]; q < nb->end[a]; q++) {
+            double e[3];
+            const double r = pair(nb, q, dim, e);
+            const size_t j = nb->j[q];
+            if (!(r < hs) || r == 0 || P->kind[j] == LUB_FLUID) continue;
+            const double cpp = S->a * (S->na[a] + S->na[j]) * dwa(dim, l0, hs, r);
+            double v[3] = {0, 0, 0}, vr = 0;
+            for (int d = 0; d < dim; d++) {
+                v[d] = S->chi[d][j] - S->chi[d][a];
+                vr += v[d] * nb->dx[d][q];
+            }
+            const double wg = lub_mph_w(dim, l0, hs, r), dwg = lub_mph_dw(dim, l0, hs, r);
+            for (int d = 0; d < dim; d++) F[d] += cpp * e[d] - ak2 * (wg * v[d] + vr * e[d] * dwg);
         }
         for (int d = 0; d < dim; d++) acc[d][a] += F[d] * dA * inv_m;
     }
