@@ -947,6 +947,17 @@ static void divergence(lub_mps *m)
     }
 }
 
+/* The right-hand side of particle i's row (T-9 negated): the PND term src (n*_i - n0), and
+ * with source mixed the projection's -rho/dt div u* (dsrc) besides it in the fluid rows of
+ * full PND (n*_i >= dlim).  The same for the standard and the LSMPS rows, and for the
+ * cavitation's release test, which asks what the row would give. */
+static double row_source(const lub_mps *m, size_t i, double src, double dsrc, double dlim)
+{
+    double b = src * (m->pnd[i] - m->n0);
+    if (dsrc > 0 && m->P->kind[i] == LUB_FLUID && m->pnd[i] >= dlim) b -= dsrc * m->div[i];
+    return b;
+}
+
 static int pressure(lub_mps *m, double dt, char *msg, size_t msgsize)
 {
     lub_particles *P = m->P;
@@ -1015,8 +1026,7 @@ assemble:
         if (dg < 0) dg = e;
         col[dg] = r;
         val[dg] = c * wsum + alpha;
-        m->b[r] = src * (m->pnd[i] - m->n0);
-        if (dsrc > 0 && P->kind[i] == LUB_FLUID && m->pnd[i] >= dlim) m->b[r] -= dsrc * m->div[i];
+        m->b[r] = row_source(m, i, src, dsrc, dlim);
         if (fix) m->b[r] += c * bfix;
         m->x[r] = P->p[i]; /* warm start from the previous pressure */
     }
@@ -1082,7 +1092,7 @@ assemble:
             col[e] = r;
             val[e++] = asum + alpha;
             if (e != len) lub_bug("LSMPS pressure row %d: %d entries, expected %d", r, e, len);
-            m->b[r] = src * (m->pnd[i] - m->n0) + bfix;
+            m->b[r] = row_source(m, i, src, dsrc, dlim) + bfix;
         }
         lub_csr_finish(&m->A2);
     }
@@ -1135,7 +1145,7 @@ assemble:
                 cav[i] = 0;
                 continue;
             }
-            double f = src * (m->pnd[i] - m->n0);
+            double f = row_source(m, i, src, dsrc, dlim);
             const int lrow = lsmps && P->kind[i] == LUB_FLUID && !m->lapflag[i];
             for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
                 size_t j = nb->j[q];
