@@ -387,6 +387,20 @@ int main(int argc, char **argv)
             }
         for (size_t i = 0; i < P.n; i++)
             for (int q = 0; q < dim; q++) P.u[q][i] -= mean[q];
+        /* and their rigid rotation (2-D: about the centroid), which no viscosity would damp:
+         * a spinning drop's centrifugal pressure would add to its Laplace pressure */
+        if (dim == 2) {
+            double cx[2] = {0, 0}, L = 0, I = 0;
+            for (size_t i = 0; i < P.n; i++) cx[0] += P.x[0][i] / P.n, cx[1] += P.x[1][i] / P.n;
+            for (size_t i = 0; i < P.n; i++) {
+                const double x = P.x[0][i] - cx[0], y = P.x[1][i] - cx[1];
+                L += x * P.u[1][i] - y * P.u[0][i], I += x * x + y * y;
+            }
+            for (size_t i = 0; i < P.n; i++) {
+                P.u[0][i] += L / I * (P.x[1][i] - cx[1]);
+                P.u[1][i] -= L / I * (P.x[0][i] - cx[0]);
+            }
+        }
         char amsg[512];
         long abad;
         if (lub_mph_step(&m, dt, &abad, amsg, sizeof amsg) != LUB_STEP_OK) {
