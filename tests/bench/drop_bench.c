@@ -166,7 +166,11 @@ static void cut_stress(const stmodel *M, const lub_particles *P, int ax, int tg,
             Fn += f[ax], Ft += f[tg], Fp += dA * pp * e[ax];
         }
     }
-    const double area = rc <= 0 ? 1.0 : dim == 2 ? 2 * rc : M_PI * rc * rc;
+    /* the whole cut: per length in 2-D, and in 3-D per length of the slab's period along z
+     * (Lx, as along x) */
+    const double area = rc <= 0    ? (dim == 3 && M->Lx > 0 ? M->Lx : 1.0)
+                        : dim == 2 ? 2 * rc
+                                   : M_PI * rc * rc;
     out[0] = Fn / area, out[1] = Ft / area, out[2] = Fp / area;
     free(na);
     for (int q = 0; q < 3; q++) free(chi[q]);
