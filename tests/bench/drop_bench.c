@@ -16,8 +16,13 @@
  * l0 = 0.1 mm, rho 1000; environment: LUB_STEPS (steps of LUB_DT, 2e-5 s), LUB_NU (1e-4),
  * LUB_KAPPA (3e3), LUB_LAMBDA (1), LUB_SIGMA (0.03), LUB_AMP (the mode-2 amplitude eps, 0.1),
  * LUB_RELAX (steps with nu 1e-4, lambda 1 before the mode is set moving), LUB_EVERY (steps
- * between printed lines, 100).  The pair sums of the mechanical pressure are over all pairs:
- * slow beyond a few thousand particles.
+ * between printed lines, 100), LUB_PACK=rings (2-D: concentric rings l0 apart instead of the
+ * lattice disc), LUB_ANNEAL=N (N steps of random velocity kicks first, their standard
+ * deviation LUB_NOISE m/s, 0.01, falling to 0), LUB_DUMP=FILE (laplace: x, y, P, the virial
+ * pressure of each particle at the end, in l0 and dp).  The laplace drop's inside pressure
+ * is read three ways: the mean P of (K-7a), the force across the two cuts, and the virial
+ * (the trace of the pair forces' stress) of the interior particles; at the end a radial
+ * profile.  The pair sums are over all pairs: slow beyond a few thousand particles.
  */
 #include <math.h>
 #include <stdio.h>
@@ -161,8 +166,77 @@ static void cut_stress(const stmodel *M, const lub_particles *P, int ax, int tg,
             Fn += f[ax], Ft += f[tg], Fp += dA * pp * e[ax];
         }
     }
-    const double area = rc <= 0 ? 1.0 : dim == 2 ? 2 * rc : M_PI * rc * rc;
+    /* the whole cut: per length in 2-D, and in 3-D per length of the slab's period along z
+     * (Lx, as along x) */
+    const double area = rc <= 0    ? (dim == 3 && M->Lx > 0 ? M->Lx : 1.0)
+                        : dim == 2 ? 2 * rc
+                                   : M_PI * rc * rc;
     out[0] = Fn / area, out[1] = Ft / area, out[2] = Fp / area;
+    free(na);
+    for (int q = 0; q < 3; q++) free(chi[q]);
+}
+
+/* The mechanical (virial) pressure of the particles within rc of centre: the trace of the
+ * stress of every pair force on them (the fluid's pressure pairs and (K-8)'s CPP and DGP
+ * pairs, at rest), -(1/(2 d dV)) sum_j r_ij . f_ij per particle i (f_ij on i from j), its
+ * mean over those particles; out[0] all pairs, out[1] the P pairs alone, out[2] the mean
+ * of P, out[3] the count. */
+static void virial(const stmodel *M, const lub_particles *P, const double centre[3], double rc,
+                   double out[4], double *wi, double *nai)
+{
+    const int dim = M->dim;
+    const size_t n = P->n;
+    double *na = lub_calloc(n, sizeof(double)), *chi[3];
+    for (int q = 0; q < 3; q++) chi[q] = lub_calloc(n, sizeof(double));
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = 0; j < n; j++) {
+            double r[3];
+            const double d = sep(M, P, i, j, r);
+            if (j == i || !(d < M->hs)) continue;
+            na[i] += k_wa(dim, M->l0, M->hs, d);
+            const double wg = lub_mph_w(dim, M->l0, M->hs, d);
+            for (int q = 0; q < dim; q++) chi[q][i] += M->ch * r[q] * wg;
+        }
+    for (size_t i = 0; i < n; i++) {
+        if (nai) nai[i] = na[i] / M->n0a;
+        na[i] = fmin(na[i] - M->n0a, 0.0);
+    }
+    const double dA = dim == 2 ? M->l0 * M->l0 : M->l0 * M->l0 * M->l0;
+    const double hp = LUB_MPH_HP * M->l0, ak2 = M->a * M->k * M->k * M->ch;
+    double sa = 0, sp = 0, sP = 0;
+    size_t cnt = 0;
+    for (size_t i = 0; i < n; i++) {
+        double off2 = 0;
+        for (int q = 0; q < dim; q++) off2 += (P->x[q][i] - centre[q]) * (P->x[q][i] - centre[q]);
+        if (off2 > rc * rc) continue;
+        cnt++, sP += P->p[i];
+        const double sa0 = sa;
+        for (size_t j = 0; j < n; j++) {
+            double r[3];
+            const double d = sep(M, P, i, j, r);
+            if (j == i || !(d < M->hs)) continue;
+            /* the force on i from j: e_ij = r/d, (chi_j - chi_i) */
+            double e[3], v[3], vr = 0;
+            for (int q = 0; q < 3; q++) {
+                e[q] = r[q] / d;
+                v[q] = q < dim ? chi[q][j] - chi[q][i] : 0.0;
+                vr += v[q] * r[q];
+            }
+            const double cpp = M->a * (na[i] + na[j]) * k_dwa(dim, M->l0, M->hs, d);
+            const double pp = d < hp ? (P->p[i] + P->p[j]) * lub_mph_dw(dim, M->l0, hp, d) : 0;
+            const double wg = lub_mph_w(dim, M->l0, M->hs, d);
+            const double dwg = lub_mph_dw(dim, M->l0, M->hs, d);
+            double rf = 0, rfp = 0;
+            for (int q = 0; q < dim; q++) {
+                rf += r[q] * dA * ((cpp + pp) * e[q] - ak2 * (wg * v[q] + vr * e[q] * dwg));
+                rfp += r[q] * dA * pp * e[q];
+            }
+            sa += -rf / (2 * dim * dA), sp += -rfp / (2 * dim * dA);
+        }
+        if (wi) wi[i] = sa - sa0;
+    }
+    out[0] = cnt ? sa / cnt : 0, out[1] = cnt ? sp / cnt : 0, out[2] = cnt ? sP / cnt : 0;
+    out[3] = (double)cnt;
     free(na);
     for (int q = 0; q < 3; q++) free(chi[q]);
 }
@@ -225,7 +299,19 @@ int main(int argc, char **argv)
                     const double x[3] = {a * l0, b * l0, c * l0};
                     lub_particles_add(&P, x, LUB_FLUID, 0, 0);
                 }
-    for (int a = -n; a <= n && !slab; a++)
+    /* LUB_PACK=rings (2-D): concentric rings l0 apart, round(2 pi k) particles on the ring
+     * of radius k l0, the last one within R0 l0: a surface of one particle per l0 */
+    const char *pack = getenv("LUB_PACK");
+    const int rings = pack && strcmp(pack, "rings") == 0 && dim == 2 && !slab;
+    for (int k = 0; rings && k < R0; k++) {
+        const int nk = k ? (int)lround(2 * M_PI * k) : 1;
+        for (int q = 0; q < nk; q++) {
+            const double th = 2 * M_PI * (q + 0.5 * (k % 2)) / nk;
+            const double x[3] = {k * l0 * cos(th), k * l0 * sin(th), 0};
+            lub_particles_add(&P, x, LUB_FLUID, 0, 0);
+        }
+    }
+    for (int a = -n; a <= n && !slab && !rings; a++)
         for (int b = -n; b <= n; b++)
             for (int c = -nz; c <= nz; c++)
                 if (a * a + b * b + c * c < R0 * R0) {
@@ -288,6 +374,44 @@ int main(int argc, char **argv)
             }
         m.c.nu = nu, m.c.bulk_viscosity = lambda;
     }
+    /* LUB_ANNEAL=N steps with random velocity kicks (zero mean, standard deviation LUB_NOISE
+     * m/s per step falling linearly to 0): the drop shaken out of its first packing */
+    const long nanneal = (long)env("LUB_ANNEAL", 0);
+    const double noise = env("LUB_NOISE", 0.01);
+    srand(12345);
+    for (long k = 0; k < nanneal; k++) {
+        const double s = noise * (1.0 - (double)k / nanneal);
+        double mean[3] = {0, 0, 0};
+        for (size_t i = 0; i < P.n; i++)
+            for (int q = 0; q < dim; q++) {
+                /* a normal deviate from Box-Muller */
+                const double u1 = (rand() + 1.0) / (RAND_MAX + 2.0), u2 = rand() / (RAND_MAX + 1.0);
+                const double g = sqrt(-2 * log(u1)) * cos(2 * M_PI * u2);
+                P.u[q][i] += s * g, mean[q] += s * g / P.n;
+            }
+        for (size_t i = 0; i < P.n; i++)
+            for (int q = 0; q < dim; q++) P.u[q][i] -= mean[q];
+        /* and their rigid rotation (2-D: about the centroid), which no viscosity would damp:
+         * a spinning drop's centrifugal pressure would add to its Laplace pressure */
+        if (dim == 2) {
+            double cx[2] = {0, 0}, L = 0, I = 0;
+            for (size_t i = 0; i < P.n; i++) cx[0] += P.x[0][i] / P.n, cx[1] += P.x[1][i] / P.n;
+            for (size_t i = 0; i < P.n; i++) {
+                const double x = P.x[0][i] - cx[0], y = P.x[1][i] - cx[1];
+                L += x * P.u[1][i] - y * P.u[0][i], I += x * x + y * y;
+            }
+            for (size_t i = 0; i < P.n; i++) {
+                P.u[0][i] += L / I * (P.x[1][i] - cx[1]);
+                P.u[1][i] -= L / I * (P.x[0][i] - cx[0]);
+            }
+        }
+        char amsg[512];
+        long abad;
+        if (lub_mph_step(&m, dt, &abad, amsg, sizeof amsg) != LUB_STEP_OK) {
+            printf("annealing step %ld failed: %s\n", k, amsg);
+            return 1;
+        }
+    }
     if (osc) { /* the velocity of mode 2 at its equilibrium crossing: u = eps omega (x, -y) */
         const double v = amp * sqrt(omega2);
         double cx[2] = {0, 0};
@@ -303,7 +427,7 @@ int main(int argc, char **argv)
     const double *pc = lub_particles_find_extra(&P, "pCohesive");
     char msg[512];
     long bad;
-    double sum = 0, sumn = 0, summ = 0;
+    double sum = 0, sumn = 0, summ = 0, sumv = 0;
     if (slab) { /* the tension of the lattice slab as built (P = 0) */
         double o[3];
         const double ctr[3] = {0, 0, 0};
@@ -382,11 +506,54 @@ int main(int argc, char **argv)
         printf("  cuts through the centre: interior pressure %.5g Pa = %.4f dp (P pairs %.4f "
                "dp)\n",
                pm, pm / dp, 0.5 * (o[2] + o2[2]) / dp);
+        double vo[4];
+        virial(&M, &P, cx, rin, vo, NULL, NULL);
+        printf("  virial over the interior: %.4f dp (P pairs %.4f dp, mean P %.4f dp, %.0f "
+               "particles)\n",
+               vo[0] / dp, vo[1] / dp, vo[2] / dp, vo[3]);
+        if (!osc && k > nsteps / 2) sumv += vo[0];
         if (!osc && k > nsteps / 2) summ += pm;
         if (!osc && k > nsteps / 2) sum += (sp + sc) / cnt, sumn++;
         printf("t %.5f: P %.5g pc %.5g sum/dp %.4f  rms u %.3g  <x2>-<y2> %.4g l0^2\n", k * dt,
                sp / cnt, sc / cnt, (sp + sc) / cnt / dp, sqrt(2 * ke), (sx - sy) / P.n / (l0 * l0));
         fflush(stdout);
+    }
+    if (!osc && !slab) { /* the radial profile at the end: bins of l0 from the centroid */
+        double cx[3] = {0, 0, 0}, vo[4];
+        for (size_t i = 0; i < P.n; i++)
+            for (int q = 0; q < dim; q++) cx[q] += P.x[q][i] / P.n;
+        double *wi = lub_calloc(P.n, sizeof(double)), *nai = lub_calloc(P.n, sizeof(double));
+        virial(&M, &P, cx, 10 * R, vo, wi, nai);
+        const double n0 = lub_mph_n0(dim, l0), hp = LUB_MPH_HP * l0;
+        const int nb = (int)(R / l0) + 3;
+        printf("radial profile (r/l0, count, P/dp, virial/dp, n/n0, n^a/n0^a):\n");
+        for (int b = 0; b < nb; b++) {
+            double sp = 0, sv = 0, sn = 0, sa = 0;
+            int cnt = 0;
+            for (size_t i = 0; i < P.n; i++) {
+                double r2 = 0;
+                for (int q = 0; q < dim; q++) r2 += (P.x[q][i] - cx[q]) * (P.x[q][i] - cx[q]);
+                if ((int)(sqrt(r2) / l0) != b) continue;
+                double np = 0;
+                for (size_t j = 0; j < P.n; j++) {
+                    double r[3];
+                    const double dd = sep(&M, &P, i, j, r);
+                    if (j != i && dd < hp) np += lub_mph_w(dim, l0, hp, dd);
+                }
+                sp += P.p[i], sv += wi[i], sn += np / n0, sa += nai[i], cnt++;
+            }
+            if (cnt)
+                printf("  %2d %4d %8.4f %8.4f %8.5f %8.5f\n", b, cnt, sp / cnt / dp, sv / cnt / dp,
+                       sn / cnt, sa / cnt);
+        }
+        if (getenv("LUB_DUMP")) {
+            FILE *fp = fopen(getenv("LUB_DUMP"), "w");
+            for (size_t i = 0; i < P.n; i++)
+                fprintf(fp, "%g %g %g %g %g\n", (P.x[0][i] - cx[0]) / l0, (P.x[1][i] - cx[1]) / l0,
+                        P.p[i] / dp, wi[i] / dp, nai[i]);
+            fclose(fp);
+        }
+        free(wi), free(nai);
     }
     if (osc) {
         printf("zero crossings:");
@@ -412,9 +579,9 @@ int main(int argc, char **argv)
     if (slab)
         printf("mean tension over the second half: %.4f sigma\n", sum / sumn);
     else if (!osc)
-        printf(
-            "mean over the second half: P + pCohesive %.4f of dp, the mechanical pressure %.4f\n",
-            sum / sumn / dp, summ / sumn / dp);
+        printf("mean over the second half: P + pCohesive %.4f of dp, the mechanical pressure %.4f "
+               "(cuts), %.4f (virial)\n",
+               sum / sumn / dp, summ / sumn / dp, sumv / sumn / dp);
     lub_mps_free(&m);
     d.model.type->free(&d.model);
     free(d.model.state);
