@@ -91,6 +91,14 @@ long lub_par_exscan(long v)
     (void)v;
     return 0;
 }
+void lub_par_sum_doubles(double *a, size_t n)
+{
+    (void)a, (void)n;
+}
+void lub_par_sum_longs(long *a, size_t n)
+{
+    (void)a, (void)n;
+}
 void lub_par_bcast_text(char *text, size_t size, int root)
 {
     (void)text, (void)size, (void)root;
@@ -250,6 +258,15 @@ long lub_par_sum_long(long v)
     long r = v;
     if (started) MPI_Allreduce(&v, &r, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
     return r;
+}
+void lub_par_sum_doubles(double *a, size_t n)
+{
+    if (started && n > 0)
+        MPI_Allreduce(MPI_IN_PLACE, a, (int)n, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+}
+void lub_par_sum_longs(long *a, size_t n)
+{
+    if (started && n > 0) MPI_Allreduce(MPI_IN_PLACE, a, (int)n, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
 }
 long lub_par_exscan(long v)
 {

@@ -81,6 +81,10 @@ void lub_par_stop(void);
 double lub_par_sum(double v);
 double lub_par_max(double v);
 long lub_par_sum_long(long v);
+/* Element-wise sums over the ranks, in place: a[k] becomes the sum of every rank's a[k]
+ * (function objects: their bins and totals over the owned particles of every rank). */
+void lub_par_sum_doubles(double *a, size_t n);
+void lub_par_sum_longs(long *a, size_t n);
 /* The sum of v over the ranks below this one. */
 long lub_par_exscan(long v);
 /* Rank 0's text to every rank (size bytes, NUL-terminated). */

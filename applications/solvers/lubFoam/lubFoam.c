@@ -364,9 +364,10 @@ int main(int argc, char **argv)
             "  rank reads the dictionaries and particles, keeps its slab and a halo of its\n"
             "  neighbours' particles, the pressure (and implicit viscosity) is solved by\n"
             "  PETSc over all ranks (solver: petsc in system/solution.yaml), rank 0 writes\n"
-            "  the time folders a serial run writes and the log.  Models other than gravity\n"
-            "  and movingWalls, fluid type mph, LSMPS Laplacians and function objects are\n"
-            "  refused (exit 1).\n"
+            "  the time folders a serial run writes, the log and the function objects' tables\n"
+            "  (totals, wallPressure, wallLoad: sums over every rank's particles).  Models\n"
+            "  other than gravity, movingWalls and collision, fluid type mph, LSMPS\n"
+            "  Laplacians and the function object forces are refused (exit 1).\n"
             "  -dryRun reads and checks every dictionary and the start particles, prints the\n"
             "  start-up figures (particles, schemes, models, Courant and diffusion numbers,\n"
             "  multi-resolution checks), runs nothing and writes nothing.\n"
@@ -427,7 +428,7 @@ int main(int argc, char **argv)
     print_header(&r, load_average, others_running);
     check_limits(&r, &geo);
     lubfoam_check_levels(&r, &geo);
-    if (parallel) lubfoam_parallel_setup(&r, &geo, lubfoam_functions_count(fos));
+    if (parallel) lubfoam_parallel_setup(&r, &geo, fos);
     lub_par_startup_done(); /* from here, a rank's error is its own */
     r.scene.geo = NULL;
     lub_geometry_free(&geo);
