@@ -37,6 +37,7 @@ typedef struct {
     /* -parallel (lubFoamParallel.c): P holds this rank's slab; the output gathers all
      * particles into G on rank 0, which writes the time folders */
     int parallel;
+    double cpu0; /* CPU seconds of the process when the time loop began (the cost) */
     lub_par par;
     lub_particles G;
 } lubfoam_run;
