@@ -1309,7 +1309,18 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
 
     /* 9. the models' corrections (collision), periodic wrap, checks; on several ranks, of
      * the owned particles (the halo, whose sums missed its far neighbours, is dropped) */
-    if (m->hooks.after_correction) m->hooks.after_correction(m->hooks.ctx, m, dt);
+    if (m->hooks.after_correction) {
+        /* on several ranks the corrections (collision: the pairs within the collision
+         * distance) read the halo's velocities and positions after the correction: their
+         * owners' (the halo's own correction summed gradients that missed the neighbours
+         * beyond the halo, and in another order) */
+        if (par)
+            for (int d = 0; d < dim; d++) {
+                lub_par_refresh(par, P->u[d], sizeof(double));
+                lub_par_refresh(par, P->x[d], sizeof(double));
+            }
+        m->hooks.after_correction(m->hooks.ctx, m, dt);
+    }
     lub_timer_start(&m->tm, LUB_T_OTHER);
     if (par) P->n = par->nown;
     wrap(m);

@@ -91,6 +91,14 @@ long lub_par_exscan(long v)
     (void)v;
     return 0;
 }
+void lub_par_sum_doubles(double *a, size_t n)
+{
+    (void)a, (void)n;
+}
+void lub_par_sum_longs(long *a, size_t n)
+{
+    (void)a, (void)n;
+}
 void lub_par_bcast_text(char *text, size_t size, int root)
 {
     (void)text, (void)size, (void)root;
@@ -250,6 +258,15 @@ long lub_par_sum_long(long v)
     long r = v;
     if (started) MPI_Allreduce(&v, &r, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
     return r;
+}
+void lub_par_sum_doubles(double *a, size_t n)
+{
+    if (started && n > 0)
+        MPI_Allreduce(MPI_IN_PLACE, a, (int)n, MPI_DOUBLE, MPI_SUM, MPI_COMM_WORLD);
+}
+void lub_par_sum_longs(long *a, size_t n)
+{
+    if (started && n > 0) MPI_Allreduce(MPI_IN_PLACE, a, (int)n, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
 }
 long lub_par_exscan(long v)
 {
@@ -527,10 +544,18 @@ void lub_par_migrate(lub_par *d, lub_particles *P)
     d->seconds += lub_wtime() - t0;
 }
 
-/* Distance along the axis from x to slab r (0 inside), the period taken into account. */
+/* Distance along the axis from x to slab r (0 inside), the period taken into account.  A
+ * periodic axis: the end slabs end at the box, [lo, cut[1]) and [cut[size-1], lo + period)
+ * (cut[0] and cut[size] are infinite for the owner's search; taken as the slab's ends, a
+ * slab reached every particle of the other end slab across the period, and the halo held
+ * the whole case). */
 static double slab_distance(const lub_par *d, int r, double x)
 {
-    const double a = d->cut[r], b = d->cut[r + 1];
+    double a = d->cut[r], b = d->cut[r + 1];
+    if (d->periodic) {
+        if (r == 0) a = d->lo;
+        if (r == d->size - 1) b = d->lo + d->period;
+    }
     double best = INFINITY;
     const int shifts = d->periodic ? 1 : 0;
     for (int s = -shifts; s <= shifts; s++) {
@@ -576,6 +601,8 @@ void lub_par_halo(lub_par *d, lub_particles *P)
     MPI_Type_free(&t);
     for (long q = 0; q < nin; q++) unpack(P, n + (size_t)q, rb + (size_t)q * nr);
     d->nhalo = (size_t)nin;
+    d->halo_sum += (double)nin;
+    d->owned_sum += (double)n;
     P->n = n + (size_t)nin;
     d->seconds += lub_wtime() - t0;
 }

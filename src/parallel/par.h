@@ -22,9 +22,9 @@
  * A halo particle is taken from every rank whose slab lies within width of it (not only the
  * adjacent ones: slabs narrower than the width are allowed), and in a periodic direction
  * along the axis across the period, with its own coordinates: the neighbour search takes the
- * minimum image.  Migration and halo exchange are all-to-all (MPI_Alltoallv): fine for the
- * tens of ranks of a workstation or a small cluster; the neighbour-only exchange of the plan
- * is for later.
+ * minimum image (the end slabs then end at the box, lo and lo + period).  Migration and
+ * halo exchange are all-to-all (MPI_Alltoallv): fine for the tens of ranks of a workstation
+ * or a small cluster; the neighbour-only exchange of the plan is for later.
  *
  * Errors: once started, a fatal error on any rank ends all (MPI_Abort with its exit status).
  * While the ranks repeat the same start-up (reading the dictionaries and the particles:
@@ -81,6 +81,10 @@ void lub_par_stop(void);
 double lub_par_sum(double v);
 double lub_par_max(double v);
 long lub_par_sum_long(long v);
+/* Element-wise sums over the ranks, in place: a[k] becomes the sum of every rank's a[k]
+ * (function objects: their bins and totals over the owned particles of every rank). */
+void lub_par_sum_doubles(double *a, size_t n);
+void lub_par_sum_longs(long *a, size_t n);
 /* The sum of v over the ranks below this one. */
 long lub_par_exscan(long v);
 /* Rank 0's text to every rank (size bytes, NUL-terminated). */
@@ -107,10 +111,11 @@ typedef struct {
     int *mcount, *mrcount, *mdispl, *mrdispl; /* migration counts */
     double seconds;                           /* in communication (exchanges, gathers) */
     size_t nmigrated;                         /* particles this rank sent away so far */
-    long interval;    /* re-balance every interval steps (0: never; set by the caller) */
-    double imbalance; /* when the fullest rank holds > (1 + imbalance) x the mean */
-    double *coord;    /* [ntotal] every rank's coordinates on the axis (re-balancing) */
-    long nbalanced;   /* re-cuts so far */
+    double halo_sum, owned_sum; /* the halo's and the owned counts summed over the halos built */
+    long interval;              /* re-balance every interval steps (0: never; set by the caller) */
+    double imbalance;           /* when the fullest rank holds > (1 + imbalance) x the mean */
+    double *coord;              /* [ntotal] every rank's coordinates on the axis (re-balancing) */
+    long nbalanced;             /* re-cuts so far */
 } lub_par;
 
 /* Slabs of the axis (0, 1, 2) of the box [lo, hi] (periodic: the axis is periodic), halo

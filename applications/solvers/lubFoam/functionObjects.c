@@ -55,6 +55,11 @@
  *              the body's shape (rigidBodies); wallLoad gives the MPS load.
  * The cost table (postProcessing/cost/<startTime>/cost.dat) is written by lubFoam itself.
  *
+ * lubFoam -parallel: totals, wallPressure and wallLoad sum over the owned particles of every
+ * rank (each rank its slab's part, lub_par_sum_doubles: the same sums as a serial run's in
+ * another order, equal to round-off), and rank 0 alone keeps the tables, their running
+ * state and their files.  forces (MPH only, not parallel) is refused by lubFoam -parallel.
+ *
  * The models' own tables (elasticWall.dat: src/models/elasticWall/io.c) are opened and
  * written with these (lub_scene_functions_start, lub_scene_functions_execute).
  */
@@ -86,6 +91,8 @@ typedef struct {
     int nbins;
     double *sum;
     long *count;
+    double *psum; /* -parallel: this step's sums and counts of this rank, then of all */
+    long *pcount;
     long samples; /* steps averaged */
     double tfirst, tlast;
 } fo;
@@ -287,11 +294,6 @@ static int wall_pressure_resume_state(fo *o, lubfoam_run *r)
 
 static void wall_pressure(fo *o, lubfoam_run *r);
 
-int lubfoam_functions_count(const lubfoam_functions *f)
-{
-    return f ? f->n : 0;
-}
-
 lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
 {
     static const char *const types[] = {"totals", "wallPressure", "wallLoad", "forces", NULL};
@@ -371,15 +373,27 @@ lubfoam_functions *lubfoam_functions_read(lubfoam_run *r)
             o->nbins = (int)nb;
             o->sum = lub_calloc((size_t)o->nbins, sizeof *o->sum);
             o->count = lub_calloc((size_t)o->nbins, sizeof *o->count);
+            o->psum = lub_calloc((size_t)o->nbins, sizeof *o->psum);
+            o->pcount = lub_calloc((size_t)o->nbins, sizeof *o->pcount);
         }
     }
     return F;
 }
 
+const char *lubfoam_functions_unparallel(const lubfoam_functions *F)
+{
+    for (int k = 0; F && k < F->n; k++)
+        if (F->f[k].type == FO_FORCES) return F->f[k].name;
+    return NULL;
+}
+
 void lubfoam_functions_start(lubfoam_functions *F, lubfoam_run *r)
 {
+    /* -parallel: rank 0 keeps the tables; every rank takes part in the sums */
+    const int writer = lubfoam_writer_rank(r);
     for (int k = 0; k < F->n; k++) {
         fo *o = &F->f[k];
+        if (!writer && o->type != FO_WALLPRESSURE) continue;
         if (o->type == FO_TOTALS) {
             char path[LUB_PATH_MAX];
             lub_postproc_path(&r->cs, o->name, r->start_name, "totals.dat", path);
@@ -409,10 +423,13 @@ void lubfoam_functions_start(lubfoam_functions *F, lubfoam_run *r)
             if (!o->fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
             lub_table_write_header(o->fp, "t[s] load[N/m] particles");
             fflush(o->fp);
-        } else if (!wall_pressure_resume(o, r) && r->step > 0 && r->step % o->interval == 0) {
+        } else {
+            /* -parallel: rank 0 continues the average; the others learn whether it did */
+            int resumed = writer ? wall_pressure_resume(o, r) : 0;
+            if (r->parallel) resumed = lub_par_max(resumed) > 0;
             /* a restart that continues no earlier average samples its start state, as the
              * run that wrote it did after that step (wall_pressure keeps to the window) */
-            wall_pressure(o, r);
+            if (!resumed && r->step > 0 && r->step % o->interval == 0) wall_pressure(o, r);
         }
     }
     lub_scene_functions_start(&r->scene, r->start_name, r->t);
@@ -449,15 +466,21 @@ static void totals(fo *o, lubfoam_run *r)
                 ke += 0.5 * mp * P->u[d][i] * P->u[d][i];
             }
         }
+        if (r->parallel) { /* the owned particles of every rank (P holds this rank's) */
+            double s[5] = {mom[0], mom[1], mom[2], ke, (double)nf};
+            lub_par_sum_doubles(s, 5);
+            mom[0] = s[0], mom[1] = s[1], mom[2] = s[2], ke = s[3], nf = (size_t)s[4];
+        }
         mass = mp * (double)nf;
     }
+    if (!lubfoam_writer_rank(r)) return;
     double row[7] = {r->t, mass, mom[0], mom[1], mom[2], ke, (double)nf};
     lub_table_write_row(o->fp, row, 7);
     fflush(o->fp);
 }
 
-/* Add the wall pressure of o's patch at this step to o->sum, o->count (bins in x). */
-static void wall_pressure_bin(fo *o, const lubfoam_run *r)
+/* Add the wall pressure of o's patch at this step to sum, count (bins in x). */
+static void wall_pressure_bin(const fo *o, const lubfoam_run *r, double *sum, long *count)
 {
     const lub_particles *P = &r->P;
     for (size_t i = 0; i < P->n; i++) {
@@ -469,8 +492,29 @@ static void wall_pressure_bin(fo *o, const lubfoam_run *r)
         if (r->scene.nlevels > 1 && lub_scene_owner(&r->scene, x) != P->level[i]) continue;
         int b = (int)((x - o->from) / o->bin);
         if (b >= o->nbins) b = o->nbins - 1;
-        o->sum[b] += P->p[i];
-        o->count[b]++;
+        sum[b] += P->p[i];
+        count[b]++;
+    }
+}
+
+/* Add this step's wall pressure of o's patch to o->sum, o->count; -parallel: every rank's
+ * owned wall particles, summed over the ranks first (rank 0's o->sum, o->count only). */
+static void wall_pressure_sample(fo *o, const lubfoam_run *r)
+{
+    if (!r->parallel) {
+        wall_pressure_bin(o, r, o->sum, o->count);
+        return;
+    }
+    const size_t nb = (size_t)o->nbins;
+    memset(o->psum, 0, nb * sizeof *o->psum);
+    memset(o->pcount, 0, nb * sizeof *o->pcount);
+    wall_pressure_bin(o, r, o->psum, o->pcount);
+    lub_par_sum_doubles(o->psum, nb);
+    lub_par_sum_longs(o->pcount, nb);
+    if (!lubfoam_writer_rank(r)) return;
+    for (size_t b = 0; b < nb; b++) {
+        o->sum[b] += o->psum[b];
+        o->count[b] += o->pcount[b];
     }
 }
 
@@ -482,7 +526,7 @@ static int in_window(const fo *o, const lubfoam_run *r)
 static void wall_pressure(fo *o, lubfoam_run *r)
 {
     if (!in_window(o, r)) return;
-    wall_pressure_bin(o, r);
+    wall_pressure_sample(o, r);
     if (!o->samples++) o->tfirst = r->t;
     o->tlast = r->t;
 }
@@ -492,7 +536,8 @@ static void wall_load(fo *o, lubfoam_run *r)
     if (!in_window(o, r)) return;
     memset(o->sum, 0, (size_t)o->nbins * sizeof *o->sum);
     memset(o->count, 0, (size_t)o->nbins * sizeof *o->count);
-    wall_pressure_bin(o, r);
+    wall_pressure_sample(o, r);
+    if (!lubfoam_writer_rank(r)) return;
     double load = 0;
     long np = 0;
     for (int b = 0; b < o->nbins; b++) {
@@ -542,6 +587,7 @@ void lubfoam_functions_execute(lubfoam_functions *F, lubfoam_run *r)
 
 void lubfoam_functions_write(lubfoam_functions *F, lubfoam_run *r)
 {
+    if (!lubfoam_writer_rank(r)) return; /* -parallel: rank 0 holds the tables */
     for (int k = 0; k < F->n; k++) {
         fo *o = &F->f[k];
         /* rows kept in stdio's buffer between writes */
@@ -601,6 +647,8 @@ void lubfoam_functions_free(lubfoam_functions *F)
         if (F->f[k].fp) fclose(F->f[k].fp);
         free(F->f[k].sum);
         free(F->f[k].count);
+        free(F->f[k].psum);
+        free(F->f[k].pcount);
         for (int d = 0; d < 3; d++) free(F->f[k].f[d]);
     }
     free(F->f);

@@ -10,6 +10,7 @@
 #include <signal.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 #include <unistd.h>
 
 #include "core/args.h"
@@ -73,6 +74,14 @@ static const char *signal_name(int sig)
     default:
         return "signal";
     }
+}
+
+/* CPU seconds of this process (all its threads). */
+static double cpu_seconds(void)
+{
+    struct timespec ts;
+    clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 static void format_hms(double s, char *buf, size_t size)
@@ -290,14 +299,33 @@ static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, 
     lub_message("Cost: %ld steps, %zu particles, %.6g particle-steps in %.3f s wall: "
                 "%.4g us per particle-step (%d threads%s)",
                 steps, np, ps, wall, us, omp_get_max_threads(), r->parallel ? " per rank" : "");
+    double comm = 0;
     if (r->parallel) {
-        /* the exchanges' time on the rank that spent most in them; rank 0's phases below */
-        const double comm = lub_par_max(r->par.seconds);
+        /* the exchanges' time on the rank that spent most in them, and least (the slab
+         * boundaries' count differs: the end slabs of a non-periodic axis have one); the
+         * solves' own messages are inside PETSc, in the phases pressureSolve and
+         * viscositySolve; rank 0's phases below */
+        comm = lub_par_max(r->par.seconds);
+        const double least = -lub_par_max(-r->par.seconds);
         const double mig = lub_par_sum((double)r->par.nmigrated);
-        lub_message("  %d ranks: communication (halo, migration, gathers) %.3f s, %.1f%% of the "
-                    "wall time (the most of any rank); %.0f particles migrated; %ld "
-                    "re-balancing cuts; rank 0's phases:",
-                    r->par.size, comm, wall > 0 ? 100 * comm / wall : 0.0, mig, r->par.nbalanced);
+        const double most = lub_par_max((double)r->par.nown);
+        /* on a shared machine the wall time counts the waits for a core; the CPU time of
+         * the ranks counts what they ran (an MPI wait that spins included) */
+        const double cpu = lub_par_sum(cpu_seconds() - r->cpu0);
+        /* the halo against the owned particles, over all ranks and steps: the work on the
+         * copies (their lists, PND, gradients) and the size of the exchanges */
+        const double halo = lub_par_sum(r->par.halo_sum), owned = lub_par_sum(r->par.owned_sum);
+        lub_message("  %d ranks: %.4g core-us per particle-step (wall x ranks x threads / "
+                    "particle-steps), %.4g by the ranks' CPU time (%.3f s); communication "
+                    "(halo, migration, gathers) %.3f s, %.1f%% of the wall time on the rank "
+                    "with the most (%.3f s on the least); halo %.1f%% of the owned particles "
+                    "(mean over ranks and steps); %.0f particles on the fullest rank at the end "
+                    "(mean %.0f); %.0f particles migrated; %ld re-balancing cuts; rank 0's "
+                    "phases:",
+                    r->par.size, us * r->par.size * omp_get_max_threads(),
+                    ps > 0 ? 1e6 * cpu / ps : 0.0, cpu, comm, wall > 0 ? 100 * comm / wall : 0.0,
+                    least, owned > 0 ? 100 * halo / owned : 0.0, most,
+                    (double)r->par.ntotal / r->par.size, mig, r->par.nbalanced);
     }
     if (!lubfoam_writer_rank(r)) return;
     for (int k = 0; k < LUB_T_COUNT; k++)
@@ -312,11 +340,11 @@ static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, 
     size_t len = (size_t)snprintf(names, sizeof names,
                                   "wallTime[s] steps particles particleSteps "
                                   "usPerParticleStep[us] threads meanPressureIterations "
-                                  "meanViscosityIterations");
+                                  "meanViscosityIterations ranks communication[s]");
     for (int k = 0; k < LUB_T_COUNT; k++) /* seconds per phase */
         len += (size_t)snprintf(names + len, sizeof names - len, " %s[s]", lub_mps_phase_names[k]);
     lub_table_write_header(fp, names);
-    enum { NFIXED = 8 };
+    enum { NFIXED = 10 };
     double row[NFIXED + LUB_T_COUNT] = {wall,
                                         (double)steps,
                                         (double)np,
@@ -324,7 +352,9 @@ static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, 
                                         us,
                                         (double)omp_get_max_threads(),
                                         steps ? pit_sum / (double)steps : 0.0,
-                                        steps ? vit_sum / (double)steps : 0.0};
+                                        steps ? vit_sum / (double)steps : 0.0,
+                                        r->parallel ? (double)r->par.size : 1.0,
+                                        comm};
     for (int k = 0; k < LUB_T_COUNT; k++) row[NFIXED + k] = phase_seconds(r, k);
     lub_table_write_row(fp, row, NFIXED + LUB_T_COUNT);
     if (lub_atomic_close(&af) != 0) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
@@ -364,9 +394,10 @@ int main(int argc, char **argv)
             "  rank reads the dictionaries and particles, keeps its slab and a halo of its\n"
             "  neighbours' particles, the pressure (and implicit viscosity) is solved by\n"
             "  PETSc over all ranks (solver: petsc in system/solution.yaml), rank 0 writes\n"
-            "  the time folders a serial run writes and the log.  Models other than gravity\n"
-            "  and movingWalls, fluid type mph, LSMPS Laplacians and function objects are\n"
-            "  refused (exit 1).\n"
+            "  the time folders a serial run writes, the log and the function objects' tables\n"
+            "  (totals, wallPressure, wallLoad: sums over every rank's particles).  Models\n"
+            "  other than gravity, movingWalls and collision, fluid type mph, LSMPS\n"
+            "  Laplacians and the function object forces are refused (exit 1).\n"
             "  -dryRun reads and checks every dictionary and the start particles, prints the\n"
             "  start-up figures (particles, schemes, models, Courant and diffusion numbers,\n"
             "  multi-resolution checks), runs nothing and writes nothing.\n"
@@ -427,7 +458,7 @@ int main(int argc, char **argv)
     print_header(&r, load_average, others_running);
     check_limits(&r, &geo);
     lubfoam_check_levels(&r, &geo);
-    if (parallel) lubfoam_parallel_setup(&r, &geo, lubfoam_functions_count(fos));
+    if (parallel) lubfoam_parallel_setup(&r, &geo, fos);
     lub_par_startup_done(); /* from here, a rank's error is its own */
     r.scene.geo = NULL;
     lub_geometry_free(&geo);
@@ -477,6 +508,7 @@ int main(int argc, char **argv)
      * whatever mpirun's output is (a log file) */
     const int tty = isatty(STDOUT_FILENO) && !r.parallel;
     const double wall0 = lub_wtime();
+    r.cpu0 = cpu_seconds();
     long steps = 0, last_write_step = -1;
     double pit_sum = 0, vit_sum = 0, last_bar = 0;
     int warned_courant = 0, warned_isolated = 0, status = LUB_EXIT_OK;

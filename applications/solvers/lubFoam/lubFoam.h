@@ -37,17 +37,19 @@ typedef struct {
     /* -parallel (lubFoamParallel.c): P holds this rank's slab; the output gathers all
      * particles into G on rank 0, which writes the time folders */
     int parallel;
+    double cpu0; /* CPU seconds of the process when the time loop began (the cost) */
     lub_par par;
     lub_particles G;
 } lubfoam_run;
 
 /* -parallel on the command line (MPI is started before the arguments are parsed). */
 int lubfoam_wants_parallel(int argc, char **argv);
-/* -parallel: system/decomposeParDict.yaml against mpirun's process count, the models and
- * solvers refused that are not parallel yet (exit 1, naming them: nfunctions, the function
- * objects, are), then this rank's slab kept and the solver told (after the scene is built
- * on all particles). */
-void lubfoam_parallel_setup(lubfoam_run *r, const lub_geometry *geo, int nfunctions);
+typedef struct lubfoam_functions lubfoam_functions;
+/* -parallel: system/decomposeParDict.yaml against mpirun's process count, the models,
+ * solvers and function objects (fos) refused that are not parallel yet (exit 1, naming
+ * them), then this rank's slab kept and the solver told (after the scene is built on all
+ * particles). */
+void lubfoam_parallel_setup(lubfoam_run *r, const lub_geometry *geo, const lubfoam_functions *fos);
 void lubfoam_parallel_free(lubfoam_run *r);
 /* Rank 0 writes (1 in a serial run). */
 static inline int lubfoam_writer_rank(const lubfoam_run *r)
@@ -63,7 +65,6 @@ void lubfoam_read_start(lubfoam_run *r);
 void lubfoam_output_init(lubfoam_run *r);
 void lubfoam_output_free(lubfoam_run *r);
 
-typedef struct lubfoam_functions lubfoam_functions;
 /* Write the current state as a time folder (atomic: the particles, uniform/state.yaml and
  * the function objects' running state in uniform/, then one rename), update
  * particles.xdmf, purge. */
@@ -91,7 +92,7 @@ void lubfoam_functions_write(lubfoam_functions *f, lubfoam_run *r);
  * it exactly. */
 void lubfoam_functions_write_state(lubfoam_functions *f, const lubfoam_run *r, const char *dir);
 void lubfoam_functions_free(lubfoam_functions *f);
-/* The number of function objects. */
-int lubfoam_functions_count(const lubfoam_functions *f);
+/* The name of the first function object that does not run in parallel (forces), or NULL. */
+const char *lubfoam_functions_unparallel(const lubfoam_functions *f);
 
 #endif

@@ -18,15 +18,16 @@ int lubfoam_wants_parallel(int argc, char **argv)
 }
 
 /* The models, formulation and schemes a parallel run has (the others refused, exit 1). */
-static void refuse_unparallel(const lubfoam_run *r, int nfunctions)
+static void refuse_unparallel(const lubfoam_run *r, const lubfoam_functions *fos)
 {
     const lub_scene *sc = &r->scene;
     const lub_mps *m = sc->level[0];
     for (int k = 0; k < sc->nmodels; k++) {
         const char *name = sc->model[k].type->name;
-        if (strcmp(name, "gravity") != 0 && strcmp(name, "movingWalls") != 0)
+        if (strcmp(name, "gravity") != 0 && strcmp(name, "movingWalls") != 0 &&
+            strcmp(name, "collision") != 0)
             lub_fatal("%s: the model '%s' does not run in parallel yet (lubFoam -parallel "
-                      "takes gravity and movingWalls): run it without -parallel "
+                      "takes gravity, movingWalls and collision): run it without -parallel "
                       "(doc/parallel.md)",
                       sc->models_path, name);
     }
@@ -51,14 +52,15 @@ static void refuse_unparallel(const lubfoam_run *r, int nfunctions)
                                                  ? m->c.p_solver.kind
                                                  : m->c.v_solver.kind],
                   m->c.p_solver.kind != LUB_LINSOLVER_PETSC ? "p" : "U");
-    if (nfunctions > 0)
-        lub_fatal("%s/system/controlDict.yaml: function objects (functions) do not run in "
-                  "parallel yet: remove them for the parallel run and sample its time folders "
-                  "with probe afterwards",
-                  r->cs.root);
+    const char *fo = lubfoam_functions_unparallel(fos);
+    if (fo)
+        lub_fatal("%s/system/controlDict.yaml: the function object '%s' (type forces) does not "
+                  "run in parallel yet (totals, wallPressure and wallLoad do): remove it for the "
+                  "parallel run",
+                  r->cs.root, fo);
 }
 
-void lubfoam_parallel_setup(lubfoam_run *r, const lub_geometry *geo, int nfunctions)
+void lubfoam_parallel_setup(lubfoam_run *r, const lub_geometry *geo, const lubfoam_functions *fos)
 {
     char path[LUB_PATH_MAX];
     const int size = lub_par_size();
@@ -66,7 +68,7 @@ void lubfoam_parallel_setup(lubfoam_run *r, const lub_geometry *geo, int nfuncti
     lub_par_read_dict(&pd, lub_case_path(&r->cs, path, "system/decomposeParDict.yaml"), r->P.dim,
                       size);
     const int ax = pd.axis;
-    refuse_unparallel(r, nfunctions);
+    refuse_unparallel(r, fos);
 
     lub_mps *m = r->scene.level[0];
     const int axis = ax < 0 ? lub_par_longest_axis(&r->P) : ax;
