@@ -417,6 +417,21 @@ static lub_solve_status lsmps_solve(lub_mps *m, lub_linsolver *s, int nrhs, doub
     return worst;
 }
 
+/* dummyVelocity extrapolate, fluid particle i: the walls around it (gp) and the curvature of
+ * the no-slip profile at them, kappa = (G/rho - g)/nu from the smoothed running mean G of the
+ * pressure gradient, which the viscous step has just put into m->grad; kept in m->kap for
+ * the wall forces (see dummy_velocity) */
+static void ghost_setup(lub_mps *m, size_t i, const double *g, lub_mps_ghost_planes *gp,
+                        double kap[3])
+{
+    lub_mps_ghost_planes_of(m, i, gp);
+    const double nu_inv = m->c.nu > 0 ? 1.0 / m->c.nu : 0.0;
+    for (int d = 0; d < m->dim; d++) {
+        kap[d] = (m->grad[d][i] / m->c.rho - g[d]) * nu_inv;
+        m->kap[d][i] = kap[d];
+    }
+}
+
 /* g: the body acceleration of the step, body: whether there is one (lub_mps_step) */
 static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg, size_t msgsize)
 {
@@ -435,8 +450,6 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
     /* dummyVelocity extrapolate: the curvature of the no-slip profile at the wall from the
      * same smoothed running mean G of the pressure gradient, (G/rho - g)/nu (dummy_velocity) */
     const int xtra = m->c.dummy_velocity == LUB_DUMMY_EXTRAPOLATE;
-    double *const *gcurv = xtra && m->gbar[0] ? m->grad : NULL;
-    const double rho_inv = 1.0 / m->c.rho, nu_inv = m->c.nu > 0 ? 1.0 / m->c.nu : 0.0;
     if (m->c.viscosity == LUB_VISCOSITY_EXPLICIT) {
         /* (T-3, T-7) with the dummy particles' ghost velocity (see dummy_velocity) */
         const double cl = lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, 1.0), nu = m->c.nu;
@@ -446,18 +459,14 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
             if (P->kind[i] != LUB_FLUID || (fix && fix[i])) continue;
             double acc[3] = {0, 0, 0}, kap[3] = {0, 0, 0}, a[3];
             lub_mps_ghost_planes gp;
-            if (xtra) lub_mps_ghost_planes_of(m, i, &gp);
-            if (gcurv)
-                for (int d = 0; d < dim; d++) kap[d] = (gcurv[d][i] * rho_inv - g[d]) * nu_inv;
-            if (m->kap[0])
-                for (int d = 0; d < dim; d++) m->kap[d][i] = kap[d];
+            if (xtra) ghost_setup(m, i, g, &gp, kap);
             for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
                 double w = nb->w[q];
                 size_t j = nb->j[q];
                 double f = 1.0;
                 a[0] = a[1] = a[2] = 0.0;
                 if (P->kind[j] == LUB_DUMMY)
-                    f = lub_mps_ghost(m, i, j, xtra ? &gp : NULL, gcurv ? kap : NULL, a);
+                    f = lub_mps_ghost(m, i, j, xtra ? &gp : NULL, xtra ? kap : NULL, a);
                 for (int d = 0; d < dim; d++) acc[d] += w * (f * (P->u[d][j] - P->u[d][i]) + a[d]);
             }
             for (int d = 0; d < dim; d++)
@@ -482,11 +491,7 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
             double wsum = 0, rhs[3] = {0, 0, 0}, kap[3] = {0, 0, 0}, a[3];
             int e = 0, dg = -1; /* the diagonal in column order (the lists are sorted) */
             lub_mps_ghost_planes gp;
-            if (xtra) lub_mps_ghost_planes_of(m, i, &gp);
-            if (gcurv)
-                for (int d = 0; d < dim; d++) kap[d] = (gcurv[d][i] * rho_inv - g[d]) * nu_inv;
-            if (m->kap[0])
-                for (int d = 0; d < dim; d++) m->kap[d][i] = kap[d];
+            if (xtra) ghost_setup(m, i, g, &gp, kap);
             for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
                 double w = nb->w[q];
                 if (w <= 0) continue;
@@ -496,7 +501,7 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
                 double f = 1.0;
                 a[0] = a[1] = a[2] = 0.0;
                 if (P->kind[j] == LUB_DUMMY)
-                    f = lub_mps_ghost(m, i, j, xtra ? &gp : NULL, gcurv ? kap : NULL, a);
+                    f = lub_mps_ghost(m, i, j, xtra ? &gp : NULL, xtra ? kap : NULL, a);
                 wsum += f * w;
                 for (int d = 0; d < dim; d++)
                     rhs[d] += f * w * (P->u[d][j] - P->u[d][i]) + 2.0 * w * a[d];

@@ -138,6 +138,24 @@ int lub_par_rebalance(lub_par *d, const lub_particles *P, double imbalance)
     (void)d, (void)P, (void)imbalance;
     NO_MPI("lub_par_rebalance")
 }
+/* Send each rank the particle records packed for it in sb (scount, sdispl: per rank, in
+ * records), receive theirs (rcount, rdispl set here) and unpack them into P from index at
+ * on; returns the number received.  what names the exchange in a capacity error. */
+static long exchange(lub_par *d, lub_particles *P, const double *sb, const int *scount,
+                     const int *sdispl, int *rcount, int *rdispl, size_t at, const char *what)
+{
+    const size_t nr = record_doubles(P);
+    MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD);
+    const long nin = displs(rcount, rdispl, d->size);
+    need_capacity(P, at + (size_t)nin, what);
+    double *rb = grow_buf(&d->rbuf, &d->rbuf_cap, (nin ? (size_t)nin : 1) * nr * sizeof(double));
+    MPI_Datatype t = record_type(nr * sizeof(double));
+    MPI_Alltoallv(sb, scount, sdispl, t, rb, rcount, rdispl, t, MPI_COMM_WORLD);
+    MPI_Type_free(&t);
+    for (long q = 0; q < nin; q++) unpack(P, at + (size_t)q, rb + (size_t)q * nr);
+    return nin;
+}
+
 void lub_par_migrate(lub_par *d, lub_particles *P)
 {
     (void)d, (void)P;
@@ -504,6 +522,24 @@ static MPI_Datatype record_type(size_t bytes)
     return t;
 }
 
+/* Send each rank the particle records packed for it in sb (scount, sdispl: per rank, in
+ * records), receive theirs (rcount, rdispl set here) and unpack them into P from index at
+ * on; returns the number received.  what names the exchange in a capacity error. */
+static long exchange(lub_par *d, lub_particles *P, const double *sb, const int *scount,
+                     const int *sdispl, int *rcount, int *rdispl, size_t at, const char *what)
+{
+    const size_t nr = record_doubles(P);
+    MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD);
+    const long nin = displs(rcount, rdispl, d->size);
+    need_capacity(P, at + (size_t)nin, what);
+    double *rb = grow_buf(&d->rbuf, &d->rbuf_cap, (nin ? (size_t)nin : 1) * nr * sizeof(double));
+    MPI_Datatype t = record_type(nr * sizeof(double));
+    MPI_Alltoallv(sb, scount, sdispl, t, rb, rcount, rdispl, t, MPI_COMM_WORLD);
+    MPI_Type_free(&t);
+    for (long q = 0; q < nin; q++) unpack(P, at + (size_t)q, rb + (size_t)q * nr);
+    return nin;
+}
+
 void lub_par_migrate(lub_par *d, lub_particles *P)
 {
     const double t0 = lub_wtime();
@@ -530,14 +566,8 @@ void lub_par_migrate(lub_par *d, lub_particles *P)
             move_particle(P, k++, i);
         }
     }
-    MPI_Alltoall(d->mcount, 1, MPI_INT, d->mrcount, 1, MPI_INT, MPI_COMM_WORLD);
-    const long nin = displs(d->mrcount, d->mrdispl, size);
-    need_capacity(P, k + (size_t)nin, "migration");
-    double *rb = grow_buf(&d->rbuf, &d->rbuf_cap, (nin ? (size_t)nin : 1) * nr * sizeof(double));
-    MPI_Datatype t = record_type(nr * sizeof(double));
-    MPI_Alltoallv(sb, d->mcount, d->mdispl, t, rb, d->mrcount, d->mrdispl, t, MPI_COMM_WORLD);
-    MPI_Type_free(&t);
-    for (long q = 0; q < nin; q++) unpack(P, k + (size_t)q, rb + (size_t)q * nr);
+    const long nin =
+        exchange(d, P, sb, d->mcount, d->mdispl, d->mrcount, d->mrdispl, k, "migration");
     d->nown = k + (size_t)nin;
     d->nmigrated += nout;
     P->n = d->nown;
@@ -592,14 +622,7 @@ void lub_par_halo(lub_par *d, lub_particles *P)
     double *sb =
         grow_buf(&d->sbuf, &d->sbuf_cap, (nsend ? (size_t)nsend : 1) * nr * sizeof(double));
     for (long q = 0; q < nsend; q++) pack(P, d->sidx[q], sb + (size_t)q * nr);
-    MPI_Alltoall(d->scount, 1, MPI_INT, d->rcount, 1, MPI_INT, MPI_COMM_WORLD);
-    const long nin = displs(d->rcount, d->rdispl, size);
-    need_capacity(P, n + (size_t)nin, "halo");
-    double *rb = grow_buf(&d->rbuf, &d->rbuf_cap, (nin ? (size_t)nin : 1) * nr * sizeof(double));
-    MPI_Datatype t = record_type(nr * sizeof(double));
-    MPI_Alltoallv(sb, d->scount, d->sdispl, t, rb, d->rcount, d->rdispl, t, MPI_COMM_WORLD);
-    MPI_Type_free(&t);
-    for (long q = 0; q < nin; q++) unpack(P, n + (size_t)q, rb + (size_t)q * nr);
+    const long nin = exchange(d, P, sb, d->scount, d->sdispl, d->rcount, d->rdispl, n, "halo");
     d->nhalo = (size_t)nin;
     d->halo_sum += (double)nin;
     d->owned_sum += (double)n;

@@ -109,16 +109,13 @@ static double sep(const stmodel *M, const lub_particles *P, size_t i, size_t j, 
     return sqrt(r2);
 }
 
-/* The force per length (2-D) or area (3-D) across the plane x[ax] = xc, restricted to the
- * crossing points within rc of centre (rc <= 0: anywhere), that the side above exerts... on
- * the side above from below: returned along ax (normal: + pushes apart, a pressure) and
- * along tg (tangential) in out[0], out[1]; and the same from the P pairs alone in out[2]. */
-static void cut_stress(const stmodel *M, const lub_particles *P, int ax, int tg, double xc,
-                       const double centre[3], double rc, double out[3])
+/* The attractive number density n^a_i and the vector chi_i of (K-8) of every particle, over
+ * all pairs within h_s (allocated here; the caller frees them) */
+static void densities(const stmodel *M, const lub_particles *P, double **na_out, double *chi[3])
 {
     const int dim = M->dim;
     const size_t n = P->n;
-    double *na = lub_calloc(n, sizeof(double)), *chi[3];
+    double *na = lub_calloc(n, sizeof(double));
     for (int q = 0; q < 3; q++) chi[q] = lub_calloc(n, sizeof(double));
     for (size_t i = 0; i < n; i++)
         for (size_t j = 0; j < n; j++) {
@@ -129,6 +126,20 @@ static void cut_stress(const stmodel *M, const lub_particles *P, int ax, int tg,
             const double wg = lub_mph_w(dim, M->l0, M->hs, d);
             for (int q = 0; q < dim; q++) chi[q][i] += M->ch * r[q] * wg;
         }
+    *na_out = na;
+}
+
+/* The force per length (2-D) or area (3-D) across the plane x[ax] = xc, restricted to the
+ * crossing points within rc of centre (rc <= 0: anywhere), that the side above exerts... on
+ * the side above from below: returned along ax (normal: + pushes apart, a pressure) and
+ * along tg (tangential) in out[0], out[1]; and the same from the P pairs alone in out[2]. */
+static void cut_stress(const stmodel *M, const lub_particles *P, int ax, int tg, double xc,
+                       const double centre[3], double rc, double out[3])
+{
+    const int dim = M->dim;
+    const size_t n = P->n;
+    double *na, *chi[3];
+    densities(M, P, &na, chi);
     for (size_t i = 0; i < n; i++) na[i] = fmin(na[i] - M->n0a, 0.0);
     const double dA = dim == 2 ? M->l0 * M->l0 : M->l0 * M->l0 * M->l0;
     const double hp = LUB_MPH_HP * M->l0, ak2 = M->a * M->k * M->k * M->ch;
@@ -186,17 +197,8 @@ static void virial(const stmodel *M, const lub_particles *P, const double centre
 {
     const int dim = M->dim;
     const size_t n = P->n;
-    double *na = lub_calloc(n, sizeof(double)), *chi[3];
-    for (int q = 0; q < 3; q++) chi[q] = lub_calloc(n, sizeof(double));
-    for (size_t i = 0; i < n; i++)
-        for (size_t j = 0; j < n; j++) {
-            double r[3];
-            const double d = sep(M, P, i, j, r);
-            if (j == i || !(d < M->hs)) continue;
-            na[i] += k_wa(dim, M->l0, M->hs, d);
-            const double wg = lub_mph_w(dim, M->l0, M->hs, d);
-            for (int q = 0; q < dim; q++) chi[q][i] += M->ch * r[q] * wg;
-        }
+    double *na, *chi[3];
+    densities(M, P, &na, chi);
     for (size_t i = 0; i < n; i++) {
         if (nai) nai[i] = na[i] / M->n0a;
         na[i] = fmin(na[i] - M->n0a, 0.0);
