@@ -6,7 +6,7 @@
  *     gradient:         lsmps        # standard (T-13) | lsmps (T-15)
  *     minPressureShift: true         # p_hat of T-14 in the gradient
  *     negativePressure: clip         # clip | keep | cavitation
- *     dummyVelocity:    mirror       # mirror (ghost 2 U - u_i) | wall (U) | extrapolate
+ *     dummyVelocity:    mirror       # mirror (ghost 2 U - u_i) | wall (U) | extrapolate | flux
  *     pressure:         { alpha: 0, gamma: 0.2, predictor: 0.1 }   # T-9; lub_mps_step
  *     freeSurface:      { beta: 0.97, asymmetry: 0.2, test: sector, sectorAngle: 60,
  *                         exposedAngle: 150 }
@@ -100,7 +100,7 @@ static void read_schemes(lub_mps_config *c, const char *path)
 {
     static const char *const grad[] = {"standard", "lsmps", NULL};
     static const char *const neg[] = {"keep", "clip", "cavitation", NULL};
-    static const char *const dummy[] = {"wall", "mirror", "extrapolate", NULL};
+    static const char *const dummy[] = {"wall", "mirror", "extrapolate", "flux", NULL};
     lub_dict *d = lub_dict_read(path);
     lub_node *r = lub_dict_root(d);
     c->re_l0 = lub_dict_real_or(r, "effectiveRadius", 3.1, LUB_BETWEEN(1.5, 6.0));

@@ -66,7 +66,9 @@ enum { LUB_NEGATIVE_KEEP = 0, LUB_NEGATIVE_CLIP = 1, LUB_NEGATIVE_CAVITATION = 2
 enum { LUB_SURFACE_SECTOR = 0, LUB_SURFACE_CENTROID = 1, LUB_SURFACE_PND = 2 };
 enum { LUB_LAPLACIAN_STANDARD = 0, LUB_LAPLACIAN_LSMPS = 1 };
 /* dummyVelocity: the wall's U, the mirror ghost 2 U - u_i, or the no-slip profile extrapolated */
-enum { LUB_DUMMY_WALL = 0, LUB_DUMMY_MIRROR = 1, LUB_DUMMY_EXTRAPOLATE = 2 };
+enum { LUB_DUMMY_WALL = 0, LUB_DUMMY_MIRROR = 1, LUB_DUMMY_EXTRAPOLATE = 2, LUB_DUMMY_FLUX = 3 };
+/* extrapolate and flux continue the no-slip profile (and need its curvature) */
+#define LUB_DUMMY_CONTINUES(v) ((v) == LUB_DUMMY_EXTRAPOLATE || (v) == LUB_DUMMY_FLUX)
 
 typedef struct {
     /* system/schemes.yaml */
@@ -152,6 +154,9 @@ typedef struct {
      * largest (n* - n0)/n0 of the interior fluid particles (fluid, not on a free surface, PND at
      * least beta n0: a full neighbourhood) at the step's r*; 0 when there are none. */
     double compression, compression_max;
+    /* since the start: fluid particles the collision model stopped at a wall's plane (its
+     * walls' holes: src/models/collision/collision.c) */
+    size_t nwallplane;
 } lub_mps_stats;
 
 /* Phases timed in every run (cost.dat columns). */
@@ -324,7 +329,8 @@ int lub_mps_wall_plane(const lub_mps *m, size_t i, unsigned patch, double cw[3],
 /* The dummy particles' velocity in the viscous term (system/schemes.yaml dummyVelocity; the
  * derivation is at step.c, dummy_velocity).  The pair term of fluid particle i and dummy
  * neighbour j is w_ij (u_g - u_i) = w_ij (f (U_j - u_i) + a) with the ghost velocity u_g:
- * lub_mps_ghost returns f and sets a (3 components).  planes: the walls around i
+ * lub_mps_ghost returns f and sets a (3 components); with dummyVelocity flux also for a wall
+ * neighbour j (f = 1, a = the wall's slip of methods.md (2.8b)).  planes: the walls around i
  * (lub_mps_ghost_planes, once per i); kappa: the no-slip profile's curvature at the wall,
  * (G/rho - g)/nu with G the pressure gradient (NULL: none). */
 #define LUB_GHOST_PLANES 4

@@ -72,7 +72,7 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
     m->cap = n;
     static const char *const gbar_names[3] = {"gradPx", "gradPy", "gradPz"};
     for (int d = 0; d < 3; d++)
-        m->gbar[d] = (c->predictor > 0 || c->dummy_velocity == LUB_DUMMY_EXTRAPOLATE) && d < m->dim
+        m->gbar[d] = (c->predictor > 0 || LUB_DUMMY_CONTINUES(c->dummy_velocity)) && d < m->dim
                          ? lub_particles_extra(P, gbar_names[d])
                          : NULL;
     m->cav =
@@ -88,7 +88,7 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
         m->bv[d] = alloc_doubles(n);
         m->xv[d] = alloc_doubles(n);
         m->grad[d] = alloc_doubles(n);
-        m->kap[d] = c->dummy_velocity == LUB_DUMMY_EXTRAPOLATE ? alloc_doubles(n) : NULL;
+        m->kap[d] = LUB_DUMMY_CONTINUES(c->dummy_velocity) ? alloc_doubles(n) : NULL;
     }
     m->pnd = alloc_doubles(n);
     m->div = c->source == LUB_SOURCE_MIXED ? alloc_doubles(n) : NULL;
@@ -449,7 +449,9 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
     if (m->gbar[0]) smooth_fluid(m, m->gbar, m->grad);
     /* dummyVelocity extrapolate: the curvature of the no-slip profile at the wall from the
      * same smoothed running mean G of the pressure gradient, (G/rho - g)/nu (dummy_velocity) */
-    const int xtra = m->c.dummy_velocity == LUB_DUMMY_EXTRAPOLATE;
+    const int xtra = LUB_DUMMY_CONTINUES(m->c.dummy_velocity);
+    /* flux: the wall particles carry the slip of (2.8b) (lub_mps_ghost) */
+    const int flux = m->c.dummy_velocity == LUB_DUMMY_FLUX;
     if (m->c.viscosity == LUB_VISCOSITY_EXPLICIT) {
         /* (T-3, T-7) with the dummy particles' ghost velocity (see dummy_velocity) */
         const double cl = lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, 1.0), nu = m->c.nu;
@@ -465,7 +467,7 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
                 size_t j = nb->j[q];
                 double f = 1.0;
                 a[0] = a[1] = a[2] = 0.0;
-                if (P->kind[j] == LUB_DUMMY)
+                if (P->kind[j] == LUB_DUMMY || (flux && P->kind[j] == LUB_WALL))
                     f = lub_mps_ghost(m, i, j, xtra ? &gp : NULL, xtra ? kap : NULL, a);
                 for (int d = 0; d < dim; d++) acc[d] += w * (f * (P->u[d][j] - P->u[d][i]) + a[d]);
             }
@@ -500,7 +502,7 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
                  * + a), f = 2 for the mirror; a enters both halves of (T-31) */
                 double f = 1.0;
                 a[0] = a[1] = a[2] = 0.0;
-                if (P->kind[j] == LUB_DUMMY)
+                if (P->kind[j] == LUB_DUMMY || (flux && P->kind[j] == LUB_WALL))
                     f = lub_mps_ghost(m, i, j, xtra ? &gp : NULL, xtra ? kap : NULL, a);
                 wsum += f * w;
                 for (int d = 0; d < dim; d++)

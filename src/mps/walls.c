@@ -358,9 +358,21 @@ double lub_mps_ghost(const lub_mps *m, size_t i, size_t j, const lub_mps_ghost_p
                      const double kappa[3], double a[3])
 {
     a[0] = a[1] = a[2] = 0.0;
+    const lub_particles *P = m->P;
+    const int flux = m->c.dummy_velocity == LUB_DUMMY_FLUX;
+    if (P->kind[j] == LUB_WALL) {
+        /* flux: a wall particle carries the slip u_s of (2.8b), the ghost's d_j = 0 */
+        int k = 0;
+        while (flux && g && kappa && k < g->n && g->patch[k] != P->patch[j]) k++;
+        if (!flux || !g || !kappa || k == g->n || !g->ok[k]) return 1.0;
+        const double *n = g->nrm[k];
+        double kn = 0.0;
+        for (int d = 0; d < m->dim; d++) kn += kappa[d] * n[d];
+        for (int d = 0; d < m->dim; d++) a[d] = -(kappa[d] - kn * n[d]) * m->l0 * m->l0 / 12.0;
+        return 1.0;
+    }
     if (m->c.dummy_velocity == LUB_DUMMY_WALL) return 1.0;
     if (m->c.dummy_velocity == LUB_DUMMY_MIRROR || !g) return 2.0;
-    const lub_particles *P = m->P;
     int k = 0;
     while (k < g->n && g->patch[k] != P->patch[j]) k++;
     if (k == g->n || !g->ok[k]) return 2.0; /* no wall layer to measure from: the mirror */
@@ -376,7 +388,13 @@ double lub_mps_ghost(const lub_mps *m, size_t i, size_t j, const lub_mps_ghost_p
     if (kappa) {
         double kn = 0.0;
         for (int d = 0; d < m->dim; d++) kn += kappa[d] * n[d];
-        for (int d = 0; d < m->dim; d++) a[d] = 0.5 * (kappa[d] - kn * n[d]) * dj * (di + dj);
+        /* flux: the profile continued from the wall's velocity plus the slip
+         * u_s = -kappa_t l0^2/12 (methods.md (2.8b)), which enters the ghost as (1 + dj/di) u_s */
+        const double s = flux ? -(1.0 + dj / di) * m->l0 * m->l0 / 12.0 : 0.0;
+        for (int d = 0; d < m->dim; d++) {
+            const double kt = kappa[d] - kn * n[d];
+            a[d] = 0.5 * kt * dj * (di + dj) + s * kt;
+        }
     }
     return 1.0 + dj / di;
 }

@@ -483,6 +483,76 @@ static void test_isolated_group(void)
     scene_close(&b);
 }
 
+/* The collision model's wall planes (src/models/collision/collision.c): in 3-D a particle
+ * coming along the normal at the centre of a square of wall particles, 0.5 l0 from the
+ * wall's plane, is 0.87 l0 from the four corners, beyond the pair rule's 0.8 l0, and would
+ * go on into the hole (tutorials/wedge3D at h0/4: through the roller's wall at step 536);
+ * within sqrt(0.8^2 - 0.5^2) l0 = 0.62 l0 of the plane it loses its approach with the
+ * restitution e: u_n = +e v.  On a 2-D wall coming straight at a wall particle (0.7 l0) the
+ * pair rule alone acts (u_n = +e v, not more: the plane finds it leaving). */
+static void collide_at(scene *s, size_t i, const double at[3], double v, int axis)
+{
+    lub_particles *P = &s->P;
+    for (size_t j = 0; j < P->n; j++)
+        for (int k = 0; k < 3; k++) P->u[k][j] = 0;
+    for (int k = 0; k < P->dim; k++) P->x[k][i] = at[k];
+    P->u[axis][i] = -v;
+    double *x[3] = {P->x[0], P->x[1], P->x[2]};
+    lub_neighbours_build(&s->m.nb, P->n, x);
+    lub_collision_apply(&s->collision, &s->m, s->dt);
+}
+
+static void test_collision_wall_plane(void)
+{
+    const double v = 0.1, e = lub_collision_defaults().restitution;
+    scene s;
+    scene_open(&s,
+               "dimension: 3\n"
+               "l0: 0.001\n"
+               "domain: { min: [0, 0, -0.004], max: [0.008, 0.008, 0.012] }\n"
+               "periodic: [x, y]\n"
+               "dummyLayers: 2\n"
+               "walls:\n"
+               "  lower: { type: plane, point: [0, 0, 0], normal: [0, 0, 1] }\n"
+               "  upper: { type: plane, point: [0, 0, 0.008], normal: [0, 0, -1] }\n"
+               "fluid:\n"
+               "  - { type: box, min: [0, 0, 0], max: [0.008, 0.008, 0.008] }\n",
+               1);
+    const size_t w = wall_near(&s, "lower", (double[3]){0.004, 0.004, 0});
+    const size_t i = fluid_near(&s, (double[3]){0.004, 0.004, 0.001});
+    const double l0 = s.l0;
+    {
+        const double at[3] = {s.P.x[0][w] + 0.5 * l0, s.P.x[1][w] + 0.5 * l0, 0.5 * l0};
+        const size_t before = s.m.st.nwallplane;
+        collide_at(&s, i, at, v, 2);
+        printf("  3-D, centre of a square 0.5 l0 above the plane: u_z %.6g (e v = %g), %zu stop\n",
+               s.P.u[2][i], e * v, s.m.st.nwallplane - before);
+        CHECK(fabs(s.P.u[2][i] - e * v) < 1e-12 * v);
+        CHECK(fabs(s.P.u[0][i]) < 1e-12 * v && fabs(s.P.u[1][i]) < 1e-12 * v);
+        CHECK(fabs(s.P.x[2][i] - (at[2] + (1 + e) * v * s.dt)) < 1e-12 * l0);
+        CHECK(s.m.st.nwallplane - before == 1);
+        /* farther than 0.62 l0 from the plane: nothing */
+        const double at2[3] = {at[0], at[1], 0.7 * l0};
+        collide_at(&s, i, at2, v, 2);
+        CHECK(s.P.u[2][i] == -v);
+    }
+    scene_close(&s);
+
+    scene_open(&s, channel2, 1);
+    {
+        const size_t w2 = wall_near(&s, "lower", (double[3]){0.004, 0, 0});
+        const size_t i2 = fluid_near(&s, (double[3]){0.004, 0.001, 0});
+        const double at[3] = {s.P.x[0][w2], s.P.x[1][w2] + 0.7 * s.l0, 0};
+        const size_t before = s.m.st.nwallplane;
+        collide_at(&s, i2, at, v, 1);
+        printf("  2-D, 0.7 l0 above a wall particle: u_y %.6g (e v = %g), %zu plane stops\n",
+               s.P.u[1][i2], e * v, s.m.st.nwallplane - before);
+        CHECK(fabs(s.P.u[1][i2] - e * v) < 1e-12 * v);
+        CHECK(s.m.st.nwallplane == before);
+    }
+    scene_close(&s);
+}
+
 int main(void)
 {
     RUN(test_plane_through);
@@ -493,5 +563,6 @@ int main(void)
     RUN(test_step_escape);
     RUN(test_step_no_alarm);
     RUN(test_isolated_group);
+    RUN(test_collision_wall_plane);
     return test_summary();
 }

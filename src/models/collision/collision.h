@@ -1,5 +1,6 @@
 /* lubkit model collision: particles closer than a collision distance stop approaching
- * (methods.md §2 step 7).
+ * (methods.md §2 step 7), and so do fluid particles closer than sqrt(d^2 - l0^2/4) to a wall's
+ * plane (methods.md (2.7a): a 3-D wall's particles leave holes that the pairs do not close).
  *
  *     collision: { distance: 0.8, restitution: 0.2 }    # distance in l0, in (0, 1]; e in [0, 1]
  *

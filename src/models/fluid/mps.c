@@ -128,7 +128,8 @@ static void mps_wall_forces(const lub_mps *m, int patch, double *const area[3],
     double dv = m->c.rho;
     for (int d = 0; d < dim; d++) dv *= m->l0;
     const double k = dv * lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, m->c.nu);
-    const int xtra = m->c.dummy_velocity == LUB_DUMMY_EXTRAPOLATE;
+    const int xtra = LUB_DUMMY_CONTINUES(m->c.dummy_velocity);
+    const int flux = m->c.dummy_velocity == LUB_DUMMY_FLUX;
     for (size_t i = 0; i < n; i++) {
         if (P->kind[i] != LUB_FLUID) continue;
         lub_mps_ghost_planes gp;
@@ -140,7 +141,7 @@ static void mps_wall_forces(const lub_mps *m, int patch, double *const area[3],
             const size_t j = nb->j[q];
             if (nb->w[q] <= 0 || P->kind[j] == LUB_FLUID || P->patch[j] != patch) continue;
             double fg = 1.0, a[3] = {0, 0, 0};
-            if (P->kind[j] == LUB_DUMMY) {
+            if (P->kind[j] == LUB_DUMMY || (flux && P->kind[j] == LUB_WALL)) {
                 if (xtra && !planes) lub_mps_ghost_planes_of(m, i, &gp), planes = 1;
                 fg = lub_mps_ghost(m, i, j, xtra ? &gp : NULL, m->kap[0] ? kap : NULL, a);
             }
