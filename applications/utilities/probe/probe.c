@@ -110,6 +110,12 @@ static const char *description =
     "      fluid particles in the two lowest particle rows (less than 1.5 l0 above the lowest\n"
     "      fluid particle), plus l0/2, the edge of its cell: at t = 0 the face of the column;\n"
     "      yTop: the highest fluid particle plus l0/2 (y is the vertical in 2-D, z in 3-D).\n"
+    "  particles [-field LIST] [-from X0 -to X1]\n"
+    "      every particle (fluid, wall, dummy) with x in [X0, X1] (default: all), one row\n"
+    "      each in the file's order: '# x y kind patch p' (3-D: x y z ...); kind 0 fluid, 1\n"
+    "      wall, 2 dummy; patch the index of its wall patch, -1 for fluid (a comment line\n"
+    "      names the patches).  A picture of the particles (gnuplot: plot ... with points,\n"
+    "      the colour by kind or patch), e.g. the oil around a rolling body.  No -average.\n"
     "\n"
     "Fields (-field, comma-separated): p, U (columns Ux Uy [Uz]), Ux, Uy, Uz, and the\n"
     "optional fields of the particle files (pMean, pnd ...); default p.\n"
@@ -119,10 +125,10 @@ static const char *description =
     "film).\n"
     "\n"
     "z-range (3-D): -z Z0:Z1 (probeDict: z: [Z0, Z1]) keeps only the particles with z in\n"
-    "[Z0, Z1] for wallPressure, line and film: a slab across the width, e.g. the mid-plane\n"
-    "of a bearing of finite width (-z -5e-6:5e-6 takes the particle row at z = 0 at l0 =\n"
-    "1e-5), or the rows near its side (line -field Uz: the side leakage).  A 2-D case, or a\n"
-    "slab with no particle, is an error.\n"
+    "[Z0, Z1] for wallPressure, line, film and particles: a slab across the width, e.g. the\n"
+    "mid-plane of a bearing of finite width (-z -5e-6:5e-6 takes the particle row at z = 0\n"
+    "at l0 = 1e-5), or the rows near its side (line -field Uz: the side leakage).  A 2-D\n"
+    "case, or a slab with no particle, is an error.\n"
     "\n"
     "Times: every time folder unless -time, -latestTime or -noZero select some.  With one time,\n"
     "or with -average, the output is one table that postErr reads directly.  With several\n"
@@ -157,6 +163,7 @@ static const char *description =
     "  probe totals -patch cylinder              (load history of the elastic wall)\n"
     "  probe wallShape -patch cylinder -latestTime -dimensionless\n"
     "  probe front -o postProcessing/probe/front.dat   (dam break: surge front against t)\n"
+    "  probe particles -field U -from 0.02 -to 0.06 -time 0.1   (a picture's particles)\n"
     "  probe -set pWall -latestTime\n"
     "\n"
     "Errors (exit 1): an unknown subcommand, patch (the patches are listed) or field (the\n"
@@ -190,6 +197,7 @@ static const int applies[PROBE_NKINDS][O_N] = {
     [PROBE_TOTALS] = {1, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0},
     [PROBE_SHAPE] = {1, 0, 1, 1, 0, 0, 0, 1, 0, 0, 0},
     [PROBE_FRONT] = {0, 0, 0, 0, 0, 0, 0, 0, 0, 0, 0},
+    [PROBE_PARTICLES] = {0, 1, 1, 1, 0, 0, 0, 0, 0, 0, 1},
 };
 
 static const char *in_case(const lub_case *c, const char *path, char *buf)
@@ -205,10 +213,11 @@ static probe_kind find_kind(const char *name)
     const char *near = lub_closest(name, probe_kind_names, PROBE_NKINDS);
     char hint[64] = "";
     if (near) snprintf(hint, sizeof hint, " (did you mean '%s'?)", near);
-    lub_fatal("unknown subcommand '%s'%s; the subcommands are: wallPressure line points film "
-              "totals wallShape front (or none: the sets of system/probeDict.yaml); see probe "
-              "-help",
-              name, hint);
+    lub_fatal(
+        "unknown subcommand '%s'%s; the subcommands are: wallPressure line points film "
+        "totals wallShape front particles (or none: the sets of system/probeDict.yaml); see probe "
+        "-help",
+        name, hint);
 }
 
 int main(int argc, char **argv)
@@ -232,7 +241,8 @@ int main(int argc, char **argv)
          "(upper) face",
          LUB_OPT_STR, &facing},
         {"-at", "'x y; x y'", "points: where to sample", LUB_OPT_STR, &at},
-        {"-z", "Z0:Z1", "wallPressure, line, film (3-D): only the particles with z in [Z0, Z1]",
+        {"-z", "Z0:Z1",
+         "wallPressure, line, film, particles (3-D): only the particles with z in [Z0, Z1]",
          LUB_OPT_STR, &zr},
         {"-history", NULL, "points: one point, one row per time: '# t p n'", LUB_OPT_FLAG,
          &history},
@@ -304,6 +314,8 @@ int main(int argc, char **argv)
         if ((kind == PROBE_WALL || kind == PROBE_SHAPE) && !patch)
             lub_fatal("%s needs -patch NAME (a wall of the case, e.g. -patch cylinder)",
                       probe_kind_names[kind]);
+        if (kind == PROBE_PARTICLES && average)
+            lub_fatal("-average does not apply to 'particles' (one row per particle and time)");
         if (kind == PROBE_POINTS && !at)
             lub_fatal("points needs -at 'x y; x y ...' (the points to sample)");
         probe_spec s;
@@ -352,8 +364,13 @@ int main(int argc, char **argv)
         for (int i = 0; i < S.n; i++) {
             if (!run[i]) continue;
             probe_spec *s = &S.sets[i];
-            if (dimensionless && s->kind != PROBE_TOTALS && s->kind != PROBE_FRONT)
+            if (dimensionless && s->kind != PROBE_TOTALS && s->kind != PROBE_FRONT &&
+                s->kind != PROBE_PARTICLES)
                 s->dimensionless = 1;
+            if (average && s->kind == PROBE_PARTICLES)
+                lub_fatal("-average does not apply to set '%s' of type particles (one row per "
+                          "particle and time)",
+                          s->name);
             if (average) s->average = 1, s->t0 = t0, s->t1 = t1, s->average_node = NULL;
             probe_sink k;
             probe_sink_init(&k, &x.c, opath, out == NULL, s->name);

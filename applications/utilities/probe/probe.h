@@ -27,6 +27,7 @@ typedef enum {
     PROBE_TOTALS,
     PROBE_SHAPE,
     PROBE_FRONT,
+    PROBE_PARTICLES,
     PROBE_NKINDS
 } probe_kind;
 

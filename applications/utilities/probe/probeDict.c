@@ -6,6 +6,7 @@
  *     film:   { type: film, bin: 2.0e-5 }
  *     totals: { type: totals }                            # patch: adds its load
  *     shape:  { type: wallShape, patch: cylinder }        # the elastic wall's deformation
+ *     near:   { type: particles, from: -0.01, to: 0.03 }  # every particle there, one row each
  *
  * Template with every key: etc/templates/probeDict.yaml.
  */
@@ -18,8 +19,8 @@
 #include "core/error.h"
 #include "probe.h"
 
-const char *const probe_kind_names[] = {"wallPressure", "line",      "points", "film",
-                                        "totals",       "wallShape", "front",  NULL};
+const char *const probe_kind_names[] = {"wallPressure", "line",  "points",    "film", "totals",
+                                        "wallShape",    "front", "particles", NULL};
 
 void probe_spec_init(probe_spec *s, probe_kind kind, const char *name)
 {
@@ -206,16 +207,19 @@ static void read_set(probe_spec *s, const char *name, lub_node *m)
         static const char *const facing[] = {"all", "down", "up", NULL};
         s->facing = (int[]){0, -1, 1}[lub_dict_choice(m, "facing", facing, 0)];
     }
-    if (kind == PROBE_WALL || kind == PROBE_LINE || kind == PROBE_POINTS) read_fields(s, m);
-    if (kind == PROBE_WALL || kind == PROBE_LINE || kind == PROBE_FILM || kind == PROBE_SHAPE) {
+    if (kind == PROBE_WALL || kind == PROBE_LINE || kind == PROBE_POINTS || kind == PROBE_PARTICLES)
+        read_fields(s, m);
+    if (kind == PROBE_WALL || kind == PROBE_LINE || kind == PROBE_FILM || kind == PROBE_SHAPE ||
+        kind == PROBE_PARTICLES) {
         s->from = lub_dict_real_or(m, "from", NAN, LUB_ANY);
         s->to = lub_dict_real_or(m, "to", NAN, LUB_ANY);
-        if (kind != PROBE_SHAPE) s->bin = lub_dict_real_or(m, "bin", NAN, LUB_POSITIVE);
+        if (kind != PROBE_SHAPE && kind != PROBE_PARTICLES)
+            s->bin = lub_dict_real_or(m, "bin", NAN, LUB_POSITIVE);
         if (!isnan(s->from) && !isnan(s->to) && !(s->from < s->to))
             lub_node_error(lub_dict_get(m, "to"), "'to' (%g) must be greater than 'from' (%g)",
                            s->to, s->from);
     }
-    if (kind == PROBE_WALL || kind == PROBE_LINE || kind == PROBE_FILM) {
+    if (kind == PROBE_WALL || kind == PROBE_LINE || kind == PROBE_FILM || kind == PROBE_PARTICLES) {
         lub_node *zn = lub_dict_find(m, "z");
         if (zn) {
             double z[2];
@@ -232,6 +236,9 @@ static void read_set(probe_spec *s, const char *name, lub_node *m)
         s->history = lub_dict_bool_or(m, "history", 0);
     }
     lub_node *av = lub_dict_find(m, "average");
+    if (av && kind == PROBE_PARTICLES)
+        lub_node_error(av, "'average' does not apply to type particles (one row per particle "
+                           "and time)");
     if (av) {
         double w[2];
         lub_dict_vec(m, "average", w, 2, 2, LUB_NONNEGATIVE);
@@ -243,7 +250,7 @@ static void read_set(probe_spec *s, const char *name, lub_node *m)
         s->t1 = w[1];
         s->average_node = av;
     }
-    if (kind != PROBE_TOTALS && kind != PROBE_FRONT)
+    if (kind != PROBE_TOTALS && kind != PROBE_FRONT && kind != PROBE_PARTICLES)
         s->dimensionless = lub_dict_bool_or(m, "dimensionless", 0);
 }
 
@@ -254,7 +261,8 @@ void probe_sets_read(probe_sets *S, const lub_case *c)
     S->dict = lub_dict_read_optional(lub_case_path(c, path, DICT));
     if (!S->dict)
         lub_fatal("no subcommand given and no %s in case '%s': give a subcommand (wallPressure, "
-                  "line, points, film, totals, wallShape) or write the dictionary; see probe "
+                  "line, points, film, totals, wallShape, front, particles) or write the "
+                  "dictionary; see probe "
                   "-help",
                   DICT, c->root);
     lub_node *root = lub_dict_root(S->dict);

@@ -1161,6 +1161,47 @@ static void run_front(job *j)
     series_emit(j, sum, NC);
 }
 
+/* ---- particles: every particle in the x-range, one row each ------------------------- */
+
+static void run_particles(job *j)
+{
+    const probe_spec *s = j->s;
+    for (size_t it = 0; it < j->nt; it++) {
+        job_read(j, it);
+        const lub_particles *P = &j->P;
+        const int dim = P->dim;
+        if (it == 0) job_fields(j);
+        job_arrays(j);
+        char h[2048] = "";
+        static const char *const axes[3] = {"x[m]", "y[m]", "z[m]"};
+        for (int d = 0; d < dim; d++) header_add(h, sizeof h, axes[d]);
+        header_add(h, sizeof h, "kind");
+        header_add(h, sizeof h, "patch");
+        for (int c = 0; c < j->f.n; c++) header_add(h, sizeof h, j->f.col[c].column);
+        const int nc = dim + 2 + j->f.n;
+        probe_block_begin(&j->b, h, nc);
+        char names[1024] = "";
+        size_t len = 0;
+        for (int k = 0; k < P->npatches && len < sizeof names; k++)
+            len +=
+                (size_t)snprintf(names + len, sizeof names - len, ", %d %s", k, P->patch_names[k]);
+        probe_block_comment(&j->b, "kind: 0 fluid, 1 wall, 2 dummy; patch: -1 fluid%s", names);
+        double row[LUB_POST_MAX_COLS + 8];
+        for (size_t i = 0; i < P->n; i++) {
+            if ((!isnan(s->from) && P->x[0][i] < s->from) || (!isnan(s->to) && P->x[0][i] > s->to))
+                continue;
+            int m = 0;
+            for (int d = 0; d < dim; d++) row[m++] = P->x[d][i];
+            row[m++] = (double)P->kind[i];
+            row[m++] = P->kind[i] == LUB_FLUID ? -1.0 : (double)P->patch[i];
+            for (int c = 0; c < j->f.n; c++) row[m++] = j->vals[c][i];
+            probe_block_row(&j->b, row);
+        }
+        lub_particles_free(&j->P);
+        job_emit(j, it);
+    }
+}
+
 /* ---- entry ---------------------------------------------------------------------------- */
 
 void probe_run(probe_ctx *x, probe_spec *s, probe_sink *k)
@@ -1170,7 +1211,8 @@ void probe_run(probe_ctx *x, probe_spec *s, probe_sink *k)
     j.x = x;
     j.s = s;
     j.k = k;
-    if (s->dimensionless && (s->kind == PROBE_TOTALS || s->kind == PROBE_FRONT))
+    if (s->dimensionless &&
+        (s->kind == PROBE_TOTALS || s->kind == PROBE_FRONT || s->kind == PROBE_PARTICLES))
         probe_error(s->node, "-dimensionless does not apply to %s", probe_kind_names[s->kind]);
     job_times(&j);
     k->tcol = !k->per_time && j.nt > 1 && !s->average && s->kind != PROBE_TOTALS &&
@@ -1200,6 +1242,9 @@ void probe_run(probe_ctx *x, probe_spec *s, probe_sink *k)
         break;
     case PROBE_FRONT:
         run_front(&j);
+        break;
+    case PROBE_PARTICLES:
+        run_particles(&j);
         break;
     default:
         lub_bug("kind %d", (int)s->kind);

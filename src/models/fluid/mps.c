@@ -98,10 +98,14 @@ static void mps_log(const lub_mps *m, double dt, double pit, char *buf, size_t s
  * mu (grad u) n, not mu (grad u + grad u^T) n: a rigid rotation, whose stress is zero, would
  * still pass mu grad(u) n = mu omega x n.  At a wall moving rigidly with the no-slip fluid,
  * (grad u)^T n is the wall's own, -omega x n (the tangential derivatives of u.n are the
- * wall's, and incompressibility gives its normal derivative), so each wall particle gets
- * -mu omega x a_i besides: no force over a closed surface, a torque -2 mu A omega on a 2-D
- * body of area A (-2 mu V omega in 3-D).  Without it the torque on a cylinder turning in a
- * fixed one tends to 5/8 of the closed form as l0 -> 0 (methods.md §7.2). */
+ * wall's, and incompressibility gives its normal derivative), so each wetted wall particle
+ * gets -mu omega x a_i besides: over a body in the fluid no force, a torque -2 mu A omega in
+ * 2-D (area A; -2 mu V omega in 3-D).  Without it the torque on a cylinder turning in a
+ * fixed one tends to 5/8 of the closed form as l0 -> 0 (methods.md §7.2).  Only where the
+ * fluid touches the wall (the pressure's test, a fluid particle within re): the term
+ * corrects the traction the fluid's pair terms carry, and a wall in air carries none.  On
+ * every wall particle it braked a roller turning in air by -2 mu A omega (issue 30: the
+ * rollingCylinder roller, dry, at 1.5 m/s^2 with nu = 3.2e-3 m^2/s). */
 static void mps_wall_forces(const lub_mps *m, int patch, double *const area[3],
                             const double omega[3], double *const f[3])
 {
@@ -109,22 +113,20 @@ static void mps_wall_forces(const lub_mps *m, int patch, double *const area[3],
     const size_t n = P->n;
     const int dim = m->dim;
     const lub_neighbours *nb = &m->nb;
+    const double mu = m->c.viscosity == LUB_VISCOSITY_NONE ? 0.0 : m->c.rho * m->c.nu;
     for (size_t i = 0; i < n; i++) {
         int wetted = 0; /* a fluid particle within re: else p_i is no fluid's pressure */
         if (P->kind[i] == LUB_WALL && P->patch[i] == patch)
             for (size_t q = nb->start[i]; q < nb->end[i] && !wetted; q++)
                 wetted = nb->w[q] > 0 && P->kind[nb->j[q]] == LUB_FLUID;
         for (int d = 0; d < 3; d++) f[d][i] = wetted && d < dim ? -P->p[i] * area[d][i] : 0.0;
-    }
-    if (m->c.viscosity == LUB_VISCOSITY_NONE) return;
-    const double mu = m->c.rho * m->c.nu;
-    for (size_t i = 0; i < n; i++) {
-        if (P->kind[i] != LUB_WALL || P->patch[i] != patch) continue;
+        if (!wetted) continue;
         const double a[3] = {area[0][i], area[1][i], area[2][i]};
         const double wxa[3] = {omega[1] * a[2] - omega[2] * a[1], omega[2] * a[0] - omega[0] * a[2],
                                omega[0] * a[1] - omega[1] * a[0]};
         for (int d = 0; d < dim; d++) f[d][i] -= mu * wxa[d];
     }
+    if (m->c.viscosity == LUB_VISCOSITY_NONE) return;
     double dv = m->c.rho;
     for (int d = 0; d < dim; d++) dv *= m->l0;
     const double k = dv * lub_mps_laplacian_coefficient(dim, m->lambda0, m->n0, m->c.nu);
