@@ -138,24 +138,6 @@ int lub_par_rebalance(lub_par *d, const lub_particles *P, double imbalance)
     (void)d, (void)P, (void)imbalance;
     NO_MPI("lub_par_rebalance")
 }
-/* Send each rank the particle records packed for it in sb (scount, sdispl: per rank, in
- * records), receive theirs (rcount, rdispl set here) and unpack them into P from index at
- * on; returns the number received.  what names the exchange in a capacity error. */
-static long exchange(lub_par *d, lub_particles *P, const double *sb, const int *scount,
-                     const int *sdispl, int *rcount, int *rdispl, size_t at, const char *what)
-{
-    const size_t nr = record_doubles(P);
-    MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD);
-    const long nin = displs(rcount, rdispl, d->size);
-    need_capacity(P, at + (size_t)nin, what);
-    double *rb = grow_buf(&d->rbuf, &d->rbuf_cap, (nin ? (size_t)nin : 1) * nr * sizeof(double));
-    MPI_Datatype t = record_type(nr * sizeof(double));
-    MPI_Alltoallv(sb, scount, sdispl, t, rb, rcount, rdispl, t, MPI_COMM_WORLD);
-    MPI_Type_free(&t);
-    for (long q = 0; q < nin; q++) unpack(P, at + (size_t)q, rb + (size_t)q * nr);
-    return nin;
-}
-
 void lub_par_migrate(lub_par *d, lub_particles *P)
 {
     (void)d, (void)P;
