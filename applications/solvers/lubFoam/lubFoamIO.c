@@ -8,7 +8,6 @@
 
 #include "core/args.h"
 #include "core/error.h"
-#include "core/timer.h"
 #include "io/dict.h"
 #include "particles/particles_io.h"
 #include "models/models.h"
@@ -230,9 +229,8 @@ void lubfoam_write(lubfoam_run *r, lubfoam_functions *fos)
         dir[0] = '\0';
         if (lubfoam_writer_rank(r)) lub_timedir_begin(&r->cs, name, dir);
         lub_par_bcast_text(dir, sizeof dir, 0);
-        const double t0 = lub_wtime();
+        /* (the file's time is the output phase's, not the communication's of the cost) */
         lub_particles_writer_write_rows(&r->writer, &r->R, r->place, first, r->par.ntotal, dir);
-        r->par.seconds += lub_wtime() - t0;
         if (!lubfoam_writer_rank(r)) return;
         lub_particles H = r->R; /* the file's header and size, for the index */
         H.n = r->par.ntotal;
