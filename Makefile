@@ -14,7 +14,10 @@
 # SANITIZE=address builds into build-asan/ with AddressSanitizer (make SANITIZE=address test).
 # PETSC=0 builds without PETSc (the 'petsc' linear solver), PETSC=1 requires it; by default
 # it is built in when installed (bin/installDeps installs it).  MPI=0 builds without MPI
-# (lubFoam -parallel); by default MPI comes with PETSc.
+# (lubFoam -parallel); by default MPI comes with PETSc.  HDF5=mpi links Open MPI's HDF5
+# (lubFoam -parallel writes and reads its particle files collectively), HDF5=serial the
+# serial one (a parallel run gathers its particles to rank 0 to write); by default mpi with
+# MPI when libhdf5-openmpi-dev is installed.  The build says which (a line "lubkit: HDF5 ...").
 #
 # Code generation: OPT (default -O3) and ARCH (default -march=native: the processor building
 # is the one running, as on a workstation or a cluster's compute node; `make ARCH=` builds
@@ -38,13 +41,8 @@ ifeq ($(SANITIZE),address)
 endif
 
 # Dependencies: pkg-config where the Debian package ships a .pc file (libyaml, HDF5);
-# SuiteSparse 5 (Debian 12) ships none, so CHOLMOD is found by its header folder.  The serial
-# HDF5 by its own name: Debian's `hdf5` is an alternative that points to the MPI build once
-# libhdf5-openmpi-dev is installed (a parallel build selects it explicitly).
-HDF5_PC       := $(if $(shell pkg-config --exists hdf5-serial 2>/dev/null && echo y),hdf5-serial,hdf5)
-PKGS          := yaml-0.1 $(HDF5_PC)
-PKG_CFLAGS    := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
-PKG_LIBS      := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
+# SuiteSparse 5 (Debian 12) ships none, so CHOLMOD is found by its header folder.
+PKGS          := yaml-0.1
 # PETSc (Debian petsc-dev, with Open MPI, hypre and MUMPS): the solver 'petsc' of
 # system/solution.yaml (src/linalg/petsc_solver.h).  Built in when pkg-config finds PETSc and
 # Open MPI's C binding (the Debian PETSc.pc does not name mpi.h's folder); PETSC=0 leaves it
@@ -69,6 +67,35 @@ ifeq ($(MPI),1)
   endif
   MPI_CFLAGS  := -DLUB_HAVE_MPI $(shell pkg-config --cflags ompi-c)
 endif
+# HDF5 (doc/parallel.md, "One HDF5 for every program"): one library for all programs, chosen
+# here.  With MPI, Open MPI's HDF5 (Debian libhdf5-openmpi-dev, pkg-config hdf5-openmpi) when
+# installed: lubFoam -parallel then writes each particle file collectively (MPI-IO, every
+# rank its rows) and a restart reads each rank's rows; the serial programs open their files
+# with HDF5's default driver and never start MPI.  PETSc links that library already (every
+# program of an MPI build loads libmpi and libhdf5_openmpi through it), so the serial HDF5
+# would be a second copy.  Otherwise the serial HDF5 by its own name (Debian's `hdf5` is an
+# alternative that points to the MPI build once libhdf5-openmpi-dev is installed), and a
+# parallel run gathers its particles to rank 0, which writes.  Only particles_io.c uses it
+# (it sees H5_HAVE_PARALLEL from hdf5.h).
+HDF5          ?= $(if $(and $(filter 1,$(MPI)),$(shell pkg-config --exists hdf5-openmpi 2>/dev/null && echo y)),mpi,serial)
+ifeq ($(HDF5),mpi)
+  ifneq ($(MPI),1)
+    $(error HDF5=mpi needs MPI (MPI=1, with PETSc))
+  endif
+  HDF5_PC     := hdf5-openmpi
+  ifeq ($(shell pkg-config --exists hdf5-openmpi 2>/dev/null && echo y),)
+    $(error HDF5=mpi but pkg-config finds no hdf5-openmpi: install libhdf5-openmpi-dev (bin/installDeps))
+  endif
+  HDF5_SAYS   := HDF5 of Open MPI (hdf5-openmpi): lubFoam -parallel writes and reads its particle files collectively
+else ifeq ($(HDF5),serial)
+  HDF5_PC     := $(if $(shell pkg-config --exists hdf5-serial 2>/dev/null && echo y),hdf5-serial,hdf5)
+  HDF5_SAYS   := serial HDF5 ($(HDF5_PC)): lubFoam -parallel gathers its particles to rank 0 to write
+else
+  $(error HDF5=$(HDF5): expected mpi or serial)
+endif
+PKGS          += $(HDF5_PC)
+PKG_CFLAGS    := $(shell pkg-config --cflags $(PKGS) 2>/dev/null)
+PKG_LIBS      := $(shell pkg-config --libs $(PKGS) 2>/dev/null)
 CHOLMOD_INC   ?= $(firstword $(wildcard /usr/include/suitesparse /usr/local/include/suitesparse))
 CHOLMOD_LIBS  ?= -lcholmod -lsuitesparseconfig
 
@@ -102,7 +129,7 @@ all: $(LIB) $(BINS)
 # The code-generation flags of the objects in $(BUILD): rewritten (and so newer than every
 # object) only when they change.
 FLAGS_STAMP := $(BUILD)/flags
-FLAGS_NOW   := $(CC) $(OPT) $(ARCH) -fno-math-errno PETSC=$(PETSC) MPI=$(MPI)
+FLAGS_NOW   := $(CC) $(OPT) $(ARCH) -fno-math-errno PETSC=$(PETSC) MPI=$(MPI) HDF5=$(HDF5)
 $(shell mkdir -p $(BUILD) && { [ "$$(cat $(FLAGS_STAMP) 2>/dev/null)" = '$(FLAGS_NOW)' ] \
           || echo '$(FLAGS_NOW)' > $(FLAGS_STAMP); })
 
@@ -115,6 +142,7 @@ $(BUILD)/obj/src/parallel/par.o: CPPFLAGS += $(MPI_CFLAGS)
 
 $(LIB): $(LIB_OBJ)
 	@mkdir -p $(dir $@)
+	@echo 'lubkit: $(HDF5_SAYS)'
 	@rm -f $@
 	ar rcs $@ $^
 

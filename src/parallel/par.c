@@ -11,9 +11,11 @@
 #include "core/error.h"
 #include "core/timer.h"
 #include "io/dict.h"
+#include "particles/particles_io.h"
 
 static const char *const methods[] = {"slabs", NULL};
 static const char *const axes[] = {"auto", "x", "y", "z", NULL};
+static const char *const writes[] = {"auto", "collective", "gather", NULL};
 
 void lub_par_read_dict(lub_par_dict *pd, const char *path, int dim, int nranks)
 {
@@ -39,6 +41,12 @@ void lub_par_read_dict(lub_par_dict *pd, const char *path, int dim, int nranks)
     pd->axis = ax - 1;
     pd->interval = lub_dict_int_or(bl, "interval", 0, 0, 1L << 40);
     pd->imbalance = lub_dict_real_or(bl, "imbalance", 0.1, LUB_NONNEGATIVE);
+    pd->write = lub_dict_choice(root, "writeParticles", writes, 0);
+    if (pd->write == LUB_PAR_WRITE_COLLECTIVE && !lub_particles_collective())
+        lub_node_error(lub_dict_find(root, "writeParticles"),
+                       "writeParticles collective, but this lubkit was built with the serial "
+                       "HDF5 (the build says which: make HDF5=mpi with libhdf5-openmpi-dev "
+                       "installed, bin/installDeps): use auto or gather");
     lub_dict_finish(dd);
     lub_dict_free(dd);
 }
@@ -138,24 +146,6 @@ int lub_par_rebalance(lub_par *d, const lub_particles *P, double imbalance)
     (void)d, (void)P, (void)imbalance;
     NO_MPI("lub_par_rebalance")
 }
-/* Send each rank the particle records packed for it in sb (scount, sdispl: per rank, in
- * records), receive theirs (rcount, rdispl set here) and unpack them into P from index at
- * on; returns the number received.  what names the exchange in a capacity error. */
-static long exchange(lub_par *d, lub_particles *P, const double *sb, const int *scount,
-                     const int *sdispl, int *rcount, int *rdispl, size_t at, const char *what)
-{
-    const size_t nr = record_doubles(P);
-    MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD);
-    const long nin = displs(rcount, rdispl, d->size);
-    need_capacity(P, at + (size_t)nin, what);
-    double *rb = grow_buf(&d->rbuf, &d->rbuf_cap, (nin ? (size_t)nin : 1) * nr * sizeof(double));
-    MPI_Datatype t = record_type(nr * sizeof(double));
-    MPI_Alltoallv(sb, scount, sdispl, t, rb, rcount, rdispl, t, MPI_COMM_WORLD);
-    MPI_Type_free(&t);
-    for (long q = 0; q < nin; q++) unpack(P, at + (size_t)q, rb + (size_t)q * nr);
-    return nin;
-}
-
 void lub_par_migrate(lub_par *d, lub_particles *P)
 {
     (void)d, (void)P;
@@ -175,6 +165,27 @@ void lub_par_gather(lub_par *d, const lub_particles *P, lub_particles *G)
 {
     (void)d, (void)P, (void)G;
     NO_MPI("lub_par_gather")
+}
+size_t lub_par_row_first(const lub_par *d, int q)
+{
+    (void)d, (void)q;
+    return 0;
+}
+int lub_par_ids_dense(const lub_par *d, const lub_particles *P)
+{
+    (void)d, (void)P;
+    NO_MPI("lub_par_ids_dense")
+}
+size_t lub_par_rows(lub_par *d, const lub_particles *P, lub_particles *R, uint64_t *place)
+{
+    (void)d, (void)P, (void)R, (void)place;
+    NO_MPI("lub_par_rows")
+}
+void lub_par_assemble(const lub_particles *S, const uint64_t *place, size_t n, lub_particles *P,
+                      const char *path)
+{
+    (void)S, (void)place, (void)n, (void)P, (void)path;
+    NO_MPI("lub_par_assemble")
 }
 
 #else
@@ -679,6 +690,137 @@ void lub_par_gather(lub_par *d, const lub_particles *P, lub_particles *G)
         G->n = (size_t)total;
     }
     d->seconds += lub_wtime() - t0;
+}
+
+/* ---- the rows of the output -------------------------------------------------------------- */
+
+size_t lub_par_row_first(const lub_par *d, int q)
+{
+    return (size_t)((unsigned long long)q * d->ntotal / (unsigned long long)d->size);
+}
+
+int lub_par_ids_dense(const lub_par *d, const lub_particles *P)
+{
+    double most = -1;
+    for (size_t i = 0; i < d->nown; i++)
+        if ((double)P->id[i] > most) most = (double)P->id[i];
+    most = lub_par_max(most);
+    return most + 1 == (double)d->ntotal;
+}
+
+/* The rank whose rows hold row r. */
+static int row_owner(const lub_par *d, uint64_t r)
+{
+    int q = (int)((unsigned long long)r * (unsigned long long)d->size / d->ntotal);
+    if (q >= d->size) q = d->size - 1;
+    while (q > 0 && lub_par_row_first(d, q) > r) q--;
+    while (q + 1 < d->size && lub_par_row_first(d, q + 1) <= r) q++;
+    return q;
+}
+
+size_t lub_par_rows(lub_par *d, const lub_particles *P, lub_particles *R, uint64_t *place)
+{
+    const double t0 = lub_wtime();
+    const int size = d->size;
+    const size_t n = d->nown, nr = record_doubles(P) + 1; /* + the place */
+    const size_t first = lub_par_row_first(d, d->rank);
+    const size_t count = lub_par_row_first(d, d->rank + 1) - first;
+    const long offset = lub_par_exscan((long)n); /* this rank's first place */
+    memset(d->mcount, 0, (size_t)size * sizeof *d->mcount);
+    for (size_t i = 0; i < n; i++) {
+        if (P->id[i] >= d->ntotal)
+            lub_bug("particle id %llu of %zu particles: the ids are not 0 .. N-1",
+                    (unsigned long long)P->id[i], d->ntotal);
+        d->mcount[row_owner(d, P->id[i])]++;
+    }
+    displs(d->mcount, d->mdispl, size);
+    double *sb = grow_buf(&d->sbuf, &d->sbuf_cap, (n ? n : 1) * nr * sizeof(double));
+    int *fill = d->scount; /* free outside the step (P->n = nown) */
+    memset(fill, 0, (size_t)size * sizeof *fill);
+    for (size_t i = 0; i < n; i++) {
+        const int o = row_owner(d, P->id[i]);
+        double *rec = sb + (size_t)(d->mdispl[o] + fill[o]++) * nr;
+        pack(P, i, rec);
+        const uint64_t at = (uint64_t)offset + i;
+        memcpy(&rec[nr - 1], &at, sizeof at);
+    }
+    MPI_Alltoall(d->mcount, 1, MPI_INT, d->mrcount, 1, MPI_INT, MPI_COMM_WORLD);
+    const long nin = displs(d->mrcount, d->mrdispl, size);
+    if ((size_t)nin != count)
+        lub_bug("rows %zu .. %zu: %ld particles received", first, first + count, nin);
+    if (R->cap < count) lub_bug("rows: %zu rows, room for %zu", count, R->cap);
+    double *rb = grow_buf(&d->rbuf, &d->rbuf_cap, (nin ? (size_t)nin : 1) * nr * sizeof(double));
+    MPI_Datatype t = record_type(nr * sizeof(double));
+    MPI_Alltoallv(sb, d->mcount, d->mdispl, t, rb, d->mrcount, d->mrdispl, t, MPI_COMM_WORLD);
+    MPI_Type_free(&t);
+    R->dim = P->dim;
+    R->time = P->time;
+    R->step = P->step;
+    R->nlevels = P->nlevels;
+    memcpy(R->levels, P->levels, sizeof R->levels);
+    R->npatches = P->npatches;
+    memcpy(R->patch_names, P->patch_names, sizeof R->patch_names);
+    for (int e = 0; e < P->nextra; e++) lub_particles_extra(R, P->extra[e].name);
+    if (R->nextra != P->nextra) lub_bug("rows: %d extra fields into %d", P->nextra, R->nextra);
+    R->n = count;
+    for (size_t r = 0; r < count; r++) R->id[r] = UINT64_MAX;
+    for (long q = 0; q < nin; q++) {
+        const double *rec = rb + (size_t)q * nr;
+        uint64_t id;
+        memcpy(&id, &rec[10], sizeof id);
+        const size_t r = (size_t)(id - first);
+        unpack(R, r, rec);
+        memcpy(&place[r], &rec[nr - 1], sizeof place[r]);
+    }
+    for (size_t r = 0; r < count; r++)
+        if (R->id[r] != first + r)
+            lub_bug("row %zu holds no particle (ids not unique?)", first + r);
+    d->seconds += lub_wtime() - t0;
+    return first;
+}
+
+void lub_par_assemble(const lub_particles *S, const uint64_t *place, size_t n, lub_particles *P,
+                      const char *path)
+{
+    const size_t nr = record_doubles(S) + 1; /* + the place */
+    int cnt = (int)S->n, *count = lub_malloc((size_t)size_ * sizeof *count);
+    int *displ = lub_malloc((size_t)size_ * sizeof *displ);
+    MPI_Allgather(&cnt, 1, MPI_INT, count, 1, MPI_INT, MPI_COMM_WORLD);
+    const long total = displs(count, displ, size_);
+    if ((size_t)total != n) lub_bug("assemble: %ld rows read of %zu", total, n);
+    double *sb = lub_malloc((S->n ? S->n : 1) * nr * sizeof(double));
+    double *rb = lub_malloc((n ? n : 1) * nr * sizeof(double));
+    for (size_t i = 0; i < S->n; i++) {
+        pack(S, i, sb + i * nr);
+        memcpy(sb + i * nr + nr - 1, &place[i], sizeof place[i]);
+    }
+    MPI_Datatype t = record_type(nr * sizeof(double));
+    MPI_Allgatherv(sb, cnt, t, rb, count, displ, t, MPI_COMM_WORLD);
+    MPI_Type_free(&t);
+    free(sb);
+    lub_particles_init(P, S->dim, n ? n : 1);
+    P->time = S->time;
+    P->step = S->step;
+    P->nlevels = S->nlevels;
+    memcpy(P->levels, S->levels, sizeof P->levels);
+    P->npatches = S->npatches;
+    memcpy(P->patch_names, S->patch_names, sizeof P->patch_names);
+    for (int e = 0; e < S->nextra; e++) lub_particles_extra(P, S->extra[e].name);
+    P->n = n;
+    unsigned char *seen = lub_calloc(n ? n : 1, 1);
+    for (size_t q = 0; q < n; q++) {
+        const double *rec = rb + q * nr;
+        uint64_t at;
+        memcpy(&at, &rec[nr - 1], sizeof at);
+        if (at >= n || seen[at]) {
+            free(seen), free(rb), free(count), free(displ);
+            lub_fatal("%s: /solver/order[%zu] = %llu: not a place of 0 .. %zu, each once", path, q,
+                      (unsigned long long)at, n - 1);
+        }
+        seen[at] = 1;
+        unpack(P, (size_t)at, rec);
+    }
+    free(seen), free(rb), free(count), free(displ);
 }
 
 #endif

@@ -50,6 +50,8 @@
  *     slabs: { axis: auto }          # auto (the fluid's longest) | x | y | z
  *     balance: { interval: 0, imbalance: 0.1 }   # re-cut every interval steps (0: never)
  *                                    # when the fullest rank holds > (1 + imbalance) x mean
+ *     writeParticles: auto           # collective (MPI-IO, every rank its rows: a build with
+ *                                    # Open MPI's HDF5) | gather (to rank 0) | auto
  *
  * Read from path for a dim-D case; nranks > 0: numberOfSubdomains must equal it (an error
  * at its line naming both otherwise).  Fatal (exit 1) at file:line on bad input. */
@@ -57,7 +59,9 @@ typedef struct {
     int axis;         /* 0, 1, 2; -1: auto */
     long interval;    /* balance.interval (0: never) */
     double imbalance; /* balance.imbalance */
+    int write;        /* writeParticles: LUB_PAR_WRITE_* */
 } lub_par_dict;
+enum { LUB_PAR_WRITE_AUTO, LUB_PAR_WRITE_COLLECTIVE, LUB_PAR_WRITE_GATHER };
 void lub_par_read_dict(lub_par_dict *pd, const char *path, int dim, int nranks);
 
 /* 1 when this build has MPI. */
@@ -149,5 +153,28 @@ void lub_par_refresh(lub_par *d, void *a, size_t elsize);
  * P's, by name), with P's time, step, levels and patches; other ranks: G untouched.
  * Collective. */
 void lub_par_gather(lub_par *d, const lub_particles *P, lub_particles *G);
+
+/* The rows of the output (lubFoam -parallel's collective write, doc/parallel.md): row r of
+ * a particle file holds the particle of id r when the ids are 0 .. N-1 (particleGen's, and
+ * kept by a parallel run: no model adds or removes particles); rank q writes rows
+ * lub_par_row_first(d, q) .. lub_par_row_first(d, q + 1) - 1, about N / size of them. */
+size_t lub_par_row_first(const lub_par *d, int q);
+/* 1 when all ranks' ids are 0 .. ntotal - 1 (their largest is ntotal - 1; ids are unique).
+ * Collective. */
+int lub_par_ids_dense(const lub_par *d, const lub_particles *P);
+/* Every rank's owned particles (P->n = nown) to the rank holding their rows: R gets this
+ * rank's rows in row order (R's capacity: its row count; its extra fields are P's, by name;
+ * P's time, step, levels and patches), place[r] the place of row r's particle in the order
+ * of lub_par_gather (rank after rank, each in its own order).  Returns the first row.
+ * Collective; the ids must be dense (lub_par_ids_dense). */
+size_t lub_par_rows(lub_par *d, const lub_particles *P, lub_particles *R, uint64_t *place);
+
+/* The rank-slice read of a restart: every rank's rows of a particle file of n particles (S
+ * and place, from lub_particles_read_rows; the ranks' slices together every row once) into
+ * P on every rank, each particle at its place: the file's particles in the solver's order,
+ * what lub_particles_read gives.  P must hold no storage.  A place out of range or twice is
+ * a fatal input error naming path.  Collective. */
+void lub_par_assemble(const lub_particles *S, const uint64_t *place, size_t n, lub_particles *P,
+                      const char *path);
 
 #endif

@@ -41,6 +41,10 @@ typedef struct {
     hid_t fapl;    /* file access property list */
     hid_t file;    /* the open file */
     int have_data; /* P holds storage that must be freed on failure */
+    int mpi;       /* the file is open on every rank of MPI_COMM_WORLD (MPI-IO driver):
+                      collective creation, this rank's rows by hyperslab */
+    int sliced;    /* reading rows first .. first + count - 1 only (lub_particles_read_rows) */
+    size_t first, count;
 } h5ctx;
 
 static void ctx_begin(h5ctx *c)
@@ -203,18 +207,20 @@ static int write_attr_string(h5ctx *c, hid_t loc, const char *name, const char *
  * chunk's checksum cheap. */
 enum { CHUNK_ROWS = 65536 };
 
-/* One dataset of n rows and ncols columns (ncols 1: rank 1).  Chunked with HDF5's
+/* One dataset of n rows and ncols columns (ncols 1: rank 1), of which this process writes
+ * rows first .. first + count - 1 from data (all of them serially; in a collective write,
+ * c->mpi, every rank its own rows, possibly none, by a hyperslab).  Chunked with HDF5's
  * Fletcher32 checksum filter, so that a damaged byte in the data (a flipped bit on a disk,
  * a copy cut short) is found when it is read, not computed with: HDF5 verifies every
  * chunk's checksum on reading.  An empty dataset cannot be chunked and holds nothing to
  * check: contiguous. */
-static int write_dataset(h5ctx *c, hid_t g, const char *name, hid_t filetype, hid_t memtype,
-                         size_t n, int ncols, const void *data)
+static int write_rows(h5ctx *c, hid_t g, const char *name, hid_t filetype, hid_t memtype, size_t n,
+                      int ncols, size_t first, size_t count, const void *data)
 {
     hsize_t dims[2] = {(hsize_t)n, (hsize_t)ncols};
     hsize_t chunk[2] = {(hsize_t)(n < CHUNK_ROWS ? n : CHUNK_ROWS), (hsize_t)ncols};
     hid_t s = H5Screate_simple(ncols > 1 ? 2 : 1, dims, NULL), d = H5I_INVALID_HID;
-    hid_t dcpl = H5I_INVALID_HID;
+    hid_t dcpl = H5I_INVALID_HID, ms = H5I_INVALID_HID, dxpl = H5P_DEFAULT;
     int rc = -1;
     if (s < 0) {
         fail_h5(c, "cannot create the dataspace of '%s'", name);
@@ -231,16 +237,54 @@ static int write_dataset(h5ctx *c, hid_t g, const char *name, hid_t filetype, hi
         fail_h5(c, "cannot create dataset '%s'", name);
         goto out;
     }
-    if (n > 0 && H5Dwrite(d, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
+    if (n > 0 && c->mpi) {
+#ifdef H5_HAVE_PARALLEL
+        /* every rank takes part in the write (HDF5 writes filtered datasets collectively
+         * only), each with its rows */
+        hsize_t start[2] = {(hsize_t)first, 0}, cnt[2] = {(hsize_t)count, (hsize_t)ncols};
+        const int rank = ncols > 1 ? 2 : 1;
+        herr_t sel = -1;
+        if ((ms = H5Screate_simple(rank, cnt, NULL)) >= 0)
+            sel = count > 0 ? H5Sselect_hyperslab(s, H5S_SELECT_SET, start, NULL, cnt, NULL)
+                  : H5Sselect_none(s) < 0 ? -1
+                                          : H5Sselect_none(ms);
+        if (sel < 0 || (dxpl = H5Pcreate(H5P_DATASET_XFER)) < 0 ||
+            H5Pset_dxpl_mpio(dxpl, H5FD_MPIO_COLLECTIVE) < 0 ||
+            H5Dwrite(d, memtype, ms, s, dxpl, data) < 0) {
+            fail_h5(c, "cannot write dataset '%s'", name);
+            goto out;
+        }
+#else
+        (void)first, (void)count;
+        lub_bug("a collective write in a build with the serial HDF5");
+#endif
+    } else if (n > 0 && H5Dwrite(d, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, data) < 0) {
         fail_h5(c, "cannot write dataset '%s'", name);
         goto out;
     }
     rc = 0;
 out:
+    if (dxpl != H5P_DEFAULT) H5Pclose(dxpl);
+    close_id(&ms, H5Sclose);
     close_id(&dcpl, H5Pclose);
     close_id(&d, H5Dclose);
     close_id(&s, H5Sclose);
     return rc;
+}
+
+/* The rows of this process: first .. first + count - 1 of n (serially all of them). */
+typedef struct {
+    size_t first, count, n;
+    const uint64_t *place; /* collective: the solver's place of each row's particle (the
+                              gathered order a parallel run's /solver/order names) */
+    int write_order;       /* /solver/order is written (the solver's order is not the id's) */
+} rows_t;
+
+/* A per-particle dataset: this process's rows. */
+static int write_dataset(h5ctx *c, hid_t g, const char *name, hid_t filetype, hid_t memtype,
+                         const rows_t *rw, int ncols, const void *data)
+{
+    return write_rows(c, g, name, filetype, memtype, rw->n, ncols, rw->first, rw->count, data);
 }
 
 static hid_t make_group(h5ctx *c, hid_t loc, const char *name)
@@ -280,7 +324,10 @@ static void gather_u64(uint64_t *buf, const uint64_t *v, const lub_particles_ran
     for (size_t r = 0; r < n; r++) buf[r] = v[rank[r].index];
 }
 
-static int write_contents(h5ctx *c, const lub_particles *P, const lub_particles_rank *rank)
+/* Every rank of a collective write makes the same calls (HDF5 creates objects and writes
+ * attributes collectively, with the same values on every rank). */
+static int write_contents(h5ctx *c, const lub_particles *P, const lub_particles_rank *rank,
+                          const rows_t *rw)
 {
     hid_t f = c->file, g = H5I_INVALID_HID, t = H5I_INVALID_HID;
     int64_t step = P->step;
@@ -311,28 +358,32 @@ static int write_contents(h5ctx *c, const lub_particles *P, const lub_particles_
         fail_h5(c, "cannot make a string type");
         goto out;
     }
-    if (write_dataset(c, f, "patches", t, t, (size_t)P->npatches, 1, P->patch_names)) goto out;
+    /* (a collective write: rank 0's copy, the same on every rank) */
+    const size_t np = (size_t)P->npatches;
+    if (write_rows(c, f, "patches", t, t, np, 1, 0, c->mpi && rw->first > 0 ? 0 : np,
+                   P->patch_names))
+        goto out;
 
     if ((g = make_group(c, f, "fields")) < 0) goto out;
-    size_t n = P->n;
+    const size_t n = rw->count;
     double *buf = c->buf;
     gather3(buf, P->x, rank, n);
-    if (write_dataset(c, g, "position", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 3, buf)) goto out;
+    if (write_dataset(c, g, "position", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, rw, 3, buf)) goto out;
     gather3(buf, P->u, rank, n);
-    if (write_dataset(c, g, "velocity", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 3, buf)) goto out;
+    if (write_dataset(c, g, "velocity", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, rw, 3, buf)) goto out;
     gather_f64(buf, P->p, rank, n);
-    if (write_dataset(c, g, "pressure", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 1, buf)) goto out;
+    if (write_dataset(c, g, "pressure", H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, rw, 1, buf)) goto out;
     gather_u8(c->buf, P->kind, rank, n);
-    if (write_dataset(c, g, "kind", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 1, c->buf)) goto out;
+    if (write_dataset(c, g, "kind", H5T_STD_U8LE, H5T_NATIVE_UINT8, rw, 1, c->buf)) goto out;
     gather_u16(c->buf, P->patch, rank, n);
-    if (write_dataset(c, g, "patch", H5T_STD_U16LE, H5T_NATIVE_UINT16, n, 1, c->buf)) goto out;
+    if (write_dataset(c, g, "patch", H5T_STD_U16LE, H5T_NATIVE_UINT16, rw, 1, c->buf)) goto out;
     gather_u8(c->buf, P->level, rank, n);
-    if (write_dataset(c, g, "level", H5T_STD_U8LE, H5T_NATIVE_UINT8, n, 1, c->buf)) goto out;
+    if (write_dataset(c, g, "level", H5T_STD_U8LE, H5T_NATIVE_UINT8, rw, 1, c->buf)) goto out;
     gather_u64(c->buf, P->id, rank, n);
-    if (write_dataset(c, g, "id", H5T_STD_U64LE, H5T_NATIVE_UINT64, n, 1, c->buf)) goto out;
+    if (write_dataset(c, g, "id", H5T_STD_U64LE, H5T_NATIVE_UINT64, rw, 1, c->buf)) goto out;
     for (int e = 0; e < P->nextra; e++) {
         gather_f64(buf, P->extra[e].v, rank, n);
-        if (write_dataset(c, g, P->extra[e].name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, n, 1, buf))
+        if (write_dataset(c, g, P->extra[e].name, H5T_IEEE_F64LE, H5T_NATIVE_DOUBLE, rw, 1, buf))
             goto out;
     }
     close_id(&g, H5Gclose);
@@ -341,18 +392,17 @@ static int write_contents(h5ctx *c, const lub_particles *P, const lub_particles_
      * the solver's arrays of the particle of row r.  The reader puts every particle back in
      * its place, so a restart continues with the very arrays the run had (its sums in the
      * same order: bit-identical to the run that was not stopped). */
-    int identity = 1;
-    for (size_t r = 0; r < n && identity; r++) identity = rank[r].index == r;
-    if (!identity) {
+    if (rw->write_order) {
         if ((g = make_group(c, f, "solver")) < 0) goto out;
-        if (n <= UINT32_MAX) {
+        if (rw->n <= UINT32_MAX) {
             uint32_t *v = c->buf;
-            for (size_t r = 0; r < n; r++) v[r] = (uint32_t)rank[r].index;
-            if (write_dataset(c, g, "order", H5T_STD_U32LE, H5T_NATIVE_UINT32, n, 1, v)) goto out;
+            for (size_t r = 0; r < n; r++)
+                v[r] = (uint32_t)(rw->place ? rw->place[r] : rank[r].index);
+            if (write_dataset(c, g, "order", H5T_STD_U32LE, H5T_NATIVE_UINT32, rw, 1, v)) goto out;
         } else {
             uint64_t *v = c->buf;
-            for (size_t r = 0; r < n; r++) v[r] = (uint64_t)rank[r].index;
-            if (write_dataset(c, g, "order", H5T_STD_U64LE, H5T_NATIVE_UINT64, n, 1, v)) goto out;
+            for (size_t r = 0; r < n; r++) v[r] = rw->place ? rw->place[r] : rank[r].index;
+            if (write_dataset(c, g, "order", H5T_STD_U64LE, H5T_NATIVE_UINT64, rw, 1, v)) goto out;
         }
         close_id(&g, H5Gclose);
     }
@@ -361,15 +411,16 @@ static int write_contents(h5ctx *c, const lub_particles *P, const lub_particles_
      * readers make no cells without it, and points without cells do not show in the Points
      * representation.  4 bytes per particle (8 beyond 2^32 particles). */
     if ((g = make_group(c, f, "xdmf")) < 0) goto out;
-    if (n <= UINT32_MAX) {
+    if (rw->n <= UINT32_MAX) {
         uint32_t *v = c->buf;
-        for (size_t i = 0; i < n; i++) v[i] = (uint32_t)i;
-        if (write_dataset(c, g, "connectivity", H5T_STD_U32LE, H5T_NATIVE_UINT32, n, 1, v))
+        for (size_t i = 0; i < n; i++) v[i] = (uint32_t)(rw->first + i);
+        if (write_dataset(c, g, "connectivity", H5T_STD_U32LE, H5T_NATIVE_UINT32, rw, 1, v))
             goto out;
     } else {
         int64_t *v = c->buf;
-        for (size_t i = 0; i < n; i++) v[i] = (int64_t)i;
-        if (write_dataset(c, g, "connectivity", H5T_STD_I64LE, H5T_NATIVE_INT64, n, 1, v)) goto out;
+        for (size_t i = 0; i < n; i++) v[i] = (int64_t)(rw->first + i);
+        if (write_dataset(c, g, "connectivity", H5T_STD_I64LE, H5T_NATIVE_INT64, rw, 1, v))
+            goto out;
     }
     rc = 0;
 out:
@@ -445,7 +496,7 @@ static int sync_parent(const char *path)
     return lub_fsync_dir(dir);
 }
 
-static void write_sidecar(const lub_particles *P, const char *dir, int sync_dir);
+static void write_sidecar(const lub_particles *P, size_t n, const char *dir, int sync_dir);
 
 void lub_particles_writer_write(lub_particles_writer *w, const lub_particles *P, const char *dir)
 {
@@ -466,6 +517,9 @@ void lub_particles_writer_write(lub_particles_writer *w, const lub_particles *P,
             lub_bug("particles %zu and %zu have the same id %llu", w->rank[r - 1].index,
                     w->rank[r].index, (unsigned long long)w->rank[r].id);
 
+    rows_t rw = {0, P->n, P->n, NULL, 0};
+    for (size_t r = 0; r < P->n && !rw.write_order; r++) rw.write_order = w->rank[r].index != r;
+
     h5ctx c;
     ctx_begin(&c);
     c.buf = w->buf;
@@ -474,7 +528,7 @@ void lub_particles_writer_write(lub_particles_writer *w, const lub_particles *P,
     else if ((c.file = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, c.fapl)) < 0)
         fail_h5(&c, "cannot create '%s'", tmp);
     else
-        write_contents(&c, P, w->rank);
+        write_contents(&c, P, w->rank, &rw);
     if (!ctx_end(&c)) {
         /* Flush to disk before the rename makes the file visible, and the folder after. */
         int fd = open(tmp, O_RDONLY);
@@ -489,7 +543,7 @@ void lub_particles_writer_write(lub_particles_writer *w, const lub_particles *P,
         unlink(tmp);
         lub_fatal_run("%s: cannot write particle file: %s", path, c.msg);
     }
-    write_sidecar(P, dir, w->sync_dir);
+    write_sidecar(P, P->n, dir, w->sync_dir);
 }
 
 /* Raise a caught fatal error again, with its status. */
@@ -516,6 +570,92 @@ void lub_particles_write(const lub_particles *P, const char *dir)
         fatal_status(c.status, "%s", c.message);
     }
 }
+
+/* ---- collective: every rank its rows (lubFoam -parallel, a build with Open MPI's HDF5) -- */
+
+#ifdef H5_HAVE_PARALLEL
+
+int lub_particles_collective(void)
+{
+    return 1;
+}
+
+void lub_particles_writer_write_rows(lub_particles_writer *w, const lub_particles *P,
+                                     const uint64_t *place, size_t first, size_t n, const char *dir)
+{
+    int rank = 0;
+    MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+    /* one temporary name for all ranks: rank 0's pid */
+    long pid = (long)getpid();
+    MPI_Bcast(&pid, 1, MPI_LONG, 0, MPI_COMM_WORLD);
+    char path[LUB_PATH_MAX], tmp[LUB_PATH_MAX];
+    if (snprintf(path, sizeof path, "%s/particles.h5", dir) >= (int)sizeof path ||
+        snprintf(tmp, sizeof tmp, "%s/particles.h5.tmp%ld", dir, pid) >= (int)sizeof tmp)
+        lub_fatal_run("path too long: '%s/particles.h5'", dir);
+    check_writable(P);
+    if (P->n > w->cap) lub_bug("%zu rows, the writer has room for %zu", P->n, w->cap);
+    if (first + P->n > n) lub_bug("rows %zu + %zu of %zu", first, P->n, n);
+    /* the rows are in id order already: the writer's map is the identity */
+    int same = 1;
+    for (size_t r = 0; r < P->n; r++) {
+        if (r > 0 && P->id[r] <= P->id[r - 1])
+            lub_bug("row %zu: id %llu after id %llu (rows not in id order)", first + r,
+                    (unsigned long long)P->id[r], (unsigned long long)P->id[r - 1]);
+        w->rank[r].id = P->id[r];
+        w->rank[r].index = r;
+        same = same && place[r] == first + r;
+    }
+    int all_same = same;
+    MPI_Allreduce(&same, &all_same, 1, MPI_INT, MPI_LAND, MPI_COMM_WORLD);
+    rows_t rw = {first, P->n, n, place, !all_same};
+
+    h5ctx c;
+    ctx_begin(&c);
+    c.buf = w->buf;
+    c.mpi = 1;
+    if ((c.fapl = file_access_plist(1)) < 0 ||
+        H5Pset_fapl_mpio(c.fapl, MPI_COMM_WORLD, MPI_INFO_NULL) < 0)
+        fail_h5(&c, "cannot make a file access property list for MPI-IO");
+    else if ((c.file = H5Fcreate(tmp, H5F_ACC_TRUNC, H5P_DEFAULT, c.fapl)) < 0)
+        fail_h5(&c, "cannot create '%s'", tmp);
+    else
+        write_contents(&c, P, w->rank, &rw);
+    ctx_end(&c); /* the collective close: every rank's rows are in the file after it */
+    int failed = c.failed, any = failed;
+    MPI_Allreduce(&failed, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    if (rank == 0 && !any) {
+        int fd = open(tmp, O_RDONLY);
+        if (fd < 0 || fsync(fd) != 0) fail(&c, "cannot sync '%s': %s", tmp, strerror(errno));
+        if (fd >= 0) close(fd);
+        if (!c.failed && rename(tmp, path) != 0)
+            fail(&c, "cannot rename '%s': %s", tmp, strerror(errno));
+        if (!c.failed && w->sync_dir && sync_parent(path) != 0)
+            fail(&c, "cannot sync the folder of '%s': %s", path, strerror(errno));
+    }
+    if (any && rank == 0) unlink(tmp);
+    if (c.failed) lub_fatal_run("%s: cannot write particle file: %s", path, c.msg);
+    if (any) /* the failing rank's message ends the run: this one waits for it */
+        lub_fatal_run("%s: cannot write particle file: another rank failed (its message "
+                      "names the reason)",
+                      path);
+    if (rank == 0) write_sidecar(P, n, dir, w->sync_dir);
+}
+
+#else
+
+int lub_particles_collective(void)
+{
+    return 0;
+}
+
+void lub_particles_writer_write_rows(lub_particles_writer *w, const lub_particles *P,
+                                     const uint64_t *place, size_t first, size_t n, const char *dir)
+{
+    (void)w, (void)P, (void)place, (void)first, (void)n, (void)dir;
+    lub_bug("a collective write in a build with the serial HDF5 (make HDF5=mpi)");
+}
+
+#endif
 
 /* ------------------------------------------------------------------------------------------ */
 /* Reading                                                                                    */
@@ -744,7 +884,16 @@ static int read_dataset(h5ctx *c, hid_t g, const char *gname, const char *name, 
     hid_t d = open_dataset(c, g, gname, name, ncols, &rows, want_float, want_int);
     if (d < 0) return -1;
     int rc = 0;
-    if (n > 0 && H5Dread(d, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)
+    if (c->sliced) { /* this process's rows: a hyperslab of the file's */
+        hid_t fs = H5Dget_space(d), ms = H5I_INVALID_HID;
+        hsize_t start[2] = {(hsize_t)c->first, 0}, cnt[2] = {(hsize_t)c->count, (hsize_t)ncols};
+        if (c->count > 0 && (fs < 0 || (ms = H5Screate_simple(ncols > 1 ? 2 : 1, cnt, NULL)) < 0 ||
+                             H5Sselect_hyperslab(fs, H5S_SELECT_SET, start, NULL, cnt, NULL) < 0 ||
+                             H5Dread(d, memtype, ms, fs, H5P_DEFAULT, buf) < 0))
+            rc = fail_h5(c, "cannot read %s/%s: the file is damaged or unreadable", gname, name);
+        close_id(&ms, H5Sclose);
+        close_id(&fs, H5Sclose);
+    } else if (n > 0 && H5Dread(d, memtype, H5S_ALL, H5S_ALL, H5P_DEFAULT, buf) < 0)
         rc = fail_h5(c, "cannot read %s/%s: the file is damaged or unreadable", gname, name);
     H5Dclose(d);
     return rc;
@@ -934,22 +1083,58 @@ static int read_shape(h5ctx *c, hid_t g, size_t *n, int *nextra,
     return 0;
 }
 
+/* The rows read: all n, or the slice's. */
+static size_t rows_read(const h5ctx *c, size_t n)
+{
+    return c->sliced ? c->count : n;
+}
+
+/* The file's row of the i-th row read. */
+static size_t file_row(const h5ctx *c, size_t i)
+{
+    return c->sliced ? c->first + i : i;
+}
+
 static int read_int_field(h5ctx *c, hid_t g, const char *name, size_t n, int64_t *tmp,
                           int64_t limit, const char *expected)
 {
     if (read_dataset(c, g, "/fields", name, 1, n, 0, 1, H5T_NATIVE_INT64, tmp)) return -1;
-    for (size_t i = 0; i < n; i++)
+    for (size_t i = 0; i < rows_read(c, n); i++)
         if (tmp[i] < 0 || tmp[i] >= limit)
-            return fail(c, "/fields/%s[%zu] = %lld, expected %s", name, i, (long long)tmp[i],
-                        expected);
+            return fail(c, "/fields/%s[%zu] = %lld, expected %s", name, file_row(c, i),
+                        (long long)tmp[i], expected);
     return 0;
 }
 
 static int check_finite(h5ctx *c, const char *name, const double *v, size_t n)
 {
-    for (size_t i = 0; i < n; i++)
-        if (!isfinite(v[i])) return fail(c, "/fields/%s[%zu] is not finite (%g)", name, i, v[i]);
+    for (size_t i = 0; i < rows_read(c, n); i++)
+        if (!isfinite(v[i]))
+            return fail(c, "/fields/%s[%zu] is not finite (%g)", name, file_row(c, i), v[i]);
     return 0;
+}
+
+/* A slice's places (lub_particles_read_rows): /solver/order's rows, or the rows themselves
+ * when the file has none (the solver's order was the id order), each below n. */
+static int read_places(h5ctx *c, size_t n, uint64_t *place)
+{
+    htri_t ex = H5Lexists(c->file, "solver", H5P_DEFAULT);
+    if (ex < 0) return fail_h5(c, "cannot look up /solver");
+    if (ex == 0) {
+        for (size_t i = 0; i < c->count; i++) place[i] = c->first + i;
+        return 0;
+    }
+    ex = H5Lexists(c->file, "solver/order", H5P_DEFAULT);
+    if (ex <= 0) return fail(c, "group /solver holds no dataset 'order'");
+    hid_t g = H5Gopen2(c->file, "solver", H5P_DEFAULT);
+    if (g < 0) return fail_h5(c, "cannot open group /solver");
+    int rc = read_dataset(c, g, "/solver", "order", 1, n, 0, 1, H5T_NATIVE_UINT64, place);
+    H5Gclose(g);
+    for (size_t i = 0; rc == 0 && i < c->count; i++)
+        if (place[i] >= n)
+            rc = fail(c, "/solver/order[%zu] = %llu: not a place of 0 .. %zu", c->first + i,
+                      (unsigned long long)place[i], n - 1);
+    return rc;
 }
 
 /* Put every particle back where the solver had it (/solver/order, written when that order
@@ -1006,7 +1191,9 @@ out:
     return rc;
 }
 
-static int read_contents(h5ctx *c, lub_particles *P)
+/* The whole file, or (c->sliced) rows first .. first + count - 1 of it with their places
+ * (place: count entries) instead of the solver's order restored. */
+static int read_contents(h5ctx *c, lub_particles *P, uint64_t *place)
 {
     hid_t f = c->file;
     lub_particles H;
@@ -1032,9 +1219,15 @@ static int read_contents(h5ctx *c, lub_particles *P)
         fail(c, "/fields/position claims %zu particles", n);
         goto out;
     }
+    if (c->sliced && (c->first > n || c->count > n - c->first)) {
+        fail(c, "rows %zu .. %zu asked of a file of %zu particles", c->first, c->first + c->count,
+             n);
+        goto out;
+    }
+    const size_t m = rows_read(c, n); /* the rows read */
 
-    /* The header is sound: set up storage (n exactly) and read the data. */
-    lub_particles_init(P, H.dim, n ? n : 1);
+    /* The header is sound: set up storage (m exactly) and read the data. */
+    lub_particles_init(P, H.dim, m ? m : 1);
     c->have_data = 1;
     P->time = H.time;
     P->step = H.step;
@@ -1042,38 +1235,39 @@ static int read_contents(h5ctx *c, lub_particles *P)
     memcpy(P->levels, H.levels, sizeof P->levels);
     P->npatches = H.npatches;
     memcpy(P->patch_names, H.patch_names, sizeof P->patch_names);
-    P->n = n;
+    P->n = m;
     for (int e = 0; e < nextra; e++) lub_particles_extra(P, extra[e]); /* names checked */
 
-    c->buf = malloc(3 * (n ? n : 1) * sizeof(double));
+    c->buf = malloc(3 * (m ? m : 1) * sizeof(double));
     c->own_buf = 1;
     if (!c->buf) {
-        fail(c, "out of memory reading %zu particles", n);
+        fail(c, "out of memory reading %zu particles", m);
         goto out;
     }
     double *buf = c->buf;
     int64_t *tmp = c->buf;
 
     if (read_dataset(c, g, "/fields", "position", 3, n, 1, 0, H5T_NATIVE_DOUBLE, buf)) goto out;
-    for (size_t i = 0; i < n; i++)
+    for (size_t i = 0; i < m; i++)
         for (int d = 0; d < 3; d++) {
             double v = buf[3 * i + d];
             if (!isfinite(v)) {
-                fail(c, "/fields/position[%zu][%d] is not finite (%g)", i, d, v);
+                fail(c, "/fields/position[%zu][%d] is not finite (%g)", file_row(c, i), d, v);
                 goto out;
             }
             if (d == 2 && P->dim == 2 && v != 0.0) {
-                fail(c, "/fields/position[%zu] has z = %g in a 2-D file (expected 0)", i, v);
+                fail(c, "/fields/position[%zu] has z = %g in a 2-D file (expected 0)",
+                     file_row(c, i), v);
                 goto out;
             }
             P->x[d][i] = v;
         }
     if (read_dataset(c, g, "/fields", "velocity", 3, n, 1, 0, H5T_NATIVE_DOUBLE, buf)) goto out;
-    for (size_t i = 0; i < n; i++)
+    for (size_t i = 0; i < m; i++)
         for (int d = 0; d < 3; d++) {
             double v = buf[3 * i + d];
             if (!isfinite(v)) {
-                fail(c, "/fields/velocity[%zu][%d] is not finite (%g)", i, d, v);
+                fail(c, "/fields/velocity[%zu][%d] is not finite (%g)", file_row(c, i), d, v);
                 goto out;
             }
             P->u[d][i] = v;
@@ -1089,22 +1283,22 @@ static int read_contents(h5ctx *c, lub_particles *P)
             goto out;
 
     if (read_int_field(c, g, "kind", n, tmp, 3, "0 (fluid), 1 (wall) or 2 (dummy)")) goto out;
-    for (size_t i = 0; i < n; i++) P->kind[i] = (uint8_t)tmp[i];
+    for (size_t i = 0; i < m; i++) P->kind[i] = (uint8_t)tmp[i];
     char expected[96];
     snprintf(expected, sizeof expected, "a level below nLevels = %d", P->nlevels);
     if (read_int_field(c, g, "level", n, tmp, P->nlevels, expected)) goto out;
-    for (size_t i = 0; i < n; i++) P->level[i] = (uint8_t)tmp[i];
+    for (size_t i = 0; i < m; i++) P->level[i] = (uint8_t)tmp[i];
     /* Fluid particles carry patch 0, meaningless; walls and dummies name a patch. */
     if (read_int_field(c, g, "patch", n, tmp, 65536, "0 to 65535")) goto out;
-    for (size_t i = 0; i < n; i++) {
+    for (size_t i = 0; i < m; i++) {
         if (tmp[i] >= P->npatches && !(P->kind[i] == LUB_FLUID && tmp[i] == 0)) {
-            fail(c, "/fields/patch[%zu] = %lld, but /patches lists %d name%s", i, (long long)tmp[i],
-                 P->npatches, P->npatches == 1 ? "" : "s");
+            fail(c, "/fields/patch[%zu] = %lld, but /patches lists %d name%s", file_row(c, i),
+                 (long long)tmp[i], P->npatches, P->npatches == 1 ? "" : "s");
             goto out;
         }
         P->patch[i] = (uint16_t)tmp[i];
     }
-    if (restore_order(c, P, n)) goto out;
+    if (c->sliced ? read_places(c, n, place) : restore_order(c, P, n)) goto out;
     rc = 0;
 out:
     close_id(&g, H5Gclose);
@@ -1132,7 +1326,24 @@ void lub_particles_read(lub_particles *P, const char *path)
     h5ctx c;
     memset(P, 0, sizeof *P);
     ctx_begin(&c);
-    if (open_for_reading(&c, path) == 0) read_contents(&c, P);
+    if (open_for_reading(&c, path) == 0) read_contents(&c, P, NULL);
+    int have_data = c.have_data;
+    if (ctx_end(&c)) {
+        if (have_data) lub_particles_free(P);
+        lub_fatal("%s: %s", path, c.msg);
+    }
+}
+
+void lub_particles_read_rows(lub_particles *P, const char *path, size_t first, size_t count,
+                             uint64_t *place)
+{
+    h5ctx c;
+    memset(P, 0, sizeof *P);
+    ctx_begin(&c);
+    c.sliced = 1;
+    c.first = first;
+    c.count = count;
+    if (open_for_reading(&c, path) == 0) read_contents(&c, P, place);
     int have_data = c.have_data;
     if (ctx_end(&c)) {
         if (have_data) lub_particles_free(P);
@@ -1290,7 +1501,7 @@ static void xdmf_tail(FILE *fp)
     fprintf(fp, "  </Domain>\n</Xdmf>\n");
 }
 
-static void write_sidecar(const lub_particles *P, const char *dir, int sync_dir)
+static void write_sidecar(const lub_particles *P, size_t n, const char *dir, int sync_dir)
 {
     char path[LUB_PATH_MAX];
     char extra[LUB_MAX_EXTRA][LUB_NAME_MAX];
@@ -1302,7 +1513,7 @@ static void write_sidecar(const lub_particles *P, const char *dir, int sync_dir)
     if (!fp) lub_fatal_run("%s: cannot write: %s", path, strerror(errno));
     af.sync_dir = sync_dir;
     xdmf_head(fp);
-    xdmf_grid(fp, 4, "particles", 0, P->time, "", P->n, P->n <= UINT32_MAX ? 4 : 8, P->nextra,
+    xdmf_grid(fp, 4, "particles", 0, P->time, "", n, n <= UINT32_MAX ? 4 : 8, P->nextra,
               (const char(*)[LUB_NAME_MAX])extra);
     xdmf_tail(fp);
     if (lub_atomic_close(&af) != 0) lub_fatal_run("%s: cannot write: %s", path, strerror(errno));

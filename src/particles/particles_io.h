@@ -61,6 +61,20 @@ void lub_particles_writer_free(lub_particles_writer *w);
 /* lub_particles_write with w's buffers. */
 void lub_particles_writer_write(lub_particles_writer *w, const lub_particles *P, const char *dir);
 
+/* 1 when this build's HDF5 is Open MPI's (make HDF5=mpi): lubFoam -parallel writes its
+ * particle files collectively. */
+int lub_particles_collective(void);
+/* The collective write of <dir>/particles.h5 (every rank of MPI_COMM_WORLD calls it, after
+ * MPI_Init, with the same dir, n and P's header: lubFoam -parallel): the file
+ * lub_particles_write writes of the particles of all ranks, through MPI-IO, this rank
+ * writing rows first .. first + P->n - 1 of n from P, which holds them in id order; place[r]
+ * is the solver's place of row r's particle (the order of all ranks' particles one rank
+ * after the other: /solver/order when it is not the id order).  Rank 0 renames the file
+ * into place after the collective close and writes particles.xdmf.  A failure on any rank
+ * is a fatal run error on all (exit 2).  A bug in a build with the serial HDF5. */
+void lub_particles_writer_write_rows(lub_particles_writer *w, const lub_particles *P,
+                                     const uint64_t *place, size_t first, size_t n,
+                                     const char *dir);
 /* Read a particle file into P, which must hold no storage (never initialised, or freed);
  * P->cap == P->n afterwards (reserve more before a time loop).  Every check of the format is
  * made (attributes, dataset presence, ranks, shapes, types, kinds, patch and level indices,
@@ -68,6 +82,15 @@ void lub_particles_writer_write(lub_particles_writer *w, const lub_particles *P,
  * naming the file, with P left holding no storage. */
 void lub_particles_read(lub_particles *P, const char *path);
 
+/* Rows first .. first + count - 1 of a particle file into P (which must hold no storage),
+ * by hyperslabs, with the checks of lub_particles_read on those rows (messages name the
+ * file's rows), and place[i] (count entries) the solver's place of row first + i's
+ * particle (/solver/order, or the row itself when the file has none: the id order), each
+ * below the file's particle count; the particles stay in row order.  The rank-slice read
+ * of a parallel restart (every rank its rows, HDF5's default driver: no collective call).
+ * Fatal input error (exit 1) as lub_particles_read, and when the rows are not in the file. */
+void lub_particles_read_rows(lub_particles *P, const char *path, size_t first, size_t count,
+                             uint64_t *place);
 /* What a particle file holds, from its header and dataset shapes only (no particle data). */
 typedef struct {
     int dim;

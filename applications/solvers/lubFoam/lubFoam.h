@@ -34,12 +34,16 @@ typedef struct {
     long write_origin_step;
     lub_particles_writer writer; /* id-order buffers for every particle the run can hold */
     lub_xdmf_series series;      /* the index of <case>/particles.xdmf */
-    /* -parallel (lubFoamParallel.c): P holds this rank's slab; the output gathers all
-     * particles into G on rank 0, which writes the time folders */
+    /* -parallel (lubFoamParallel.c): P holds this rank's slab.  The particle files: written
+     * collectively (collective: every rank its rows R, in id order, place their solver's
+     * places), or gathered into G on rank 0; rank 0 writes the rest of the time folders */
     int parallel;
     double cpu0; /* CPU seconds of the process when the time loop began (the cost) */
     lub_par par;
     lub_particles G;
+    int collective;
+    lub_particles R;
+    uint64_t *place;
 } lubfoam_run;
 
 /* -parallel on the command line (MPI is started before the arguments are parsed). */
@@ -51,7 +55,8 @@ typedef struct lubfoam_functions lubfoam_functions;
  * particles). */
 void lubfoam_parallel_setup(lubfoam_run *r, const lub_geometry *geo, const lubfoam_functions *fos);
 void lubfoam_parallel_free(lubfoam_run *r);
-/* Rank 0 writes (1 in a serial run). */
+/* Rank 0 writes the time folders (1 in a serial run); with r->collective every rank writes
+ * its rows of the particle file. */
 static inline int lubfoam_writer_rank(const lubfoam_run *r)
 {
     return !r->parallel || r->par.rank == 0;

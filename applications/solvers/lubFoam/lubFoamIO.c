@@ -69,6 +69,42 @@ static void warn_earlier_results(const lub_case *cs, const char *start)
     free(t);
 }
 
+/* -parallel: the rank-slice read.  Each rank reads its rows of the file (about N / size, by
+ * hyperslabs: the file is read once over the ranks, not once per rank), and the slices
+ * together make every rank's particles, each at its place in the solver's order: what
+ * lub_particles_read gives, since the start-up still builds the scene on all particles
+ * (doc/parallel.md, per-rank capacity).  An error in one rank's rows is every rank's (rank
+ * 0 prints it, as the start-up's other errors). */
+static void read_start_parallel(lubfoam_run *r, const char *path)
+{
+    lub_particles_info info;
+    lub_particles_read_info(path, &info);
+    const int q = lub_par_rank(), size = lub_par_size();
+    const size_t first = (size_t)((unsigned long long)q * info.n / (unsigned long long)size);
+    const size_t count =
+        (size_t)((unsigned long long)(q + 1) * info.n / (unsigned long long)size) - first;
+    uint64_t *place = lub_malloc((count ? count : 1) * sizeof *place);
+    lub_particles S;
+    char msg[2048] = "";
+    int failed = 0;
+    lub_catcher c;
+    if (lub_error_catch(&c) == 0) {
+        lub_particles_read_rows(&S, path, first, count, place);
+        lub_error_uncatch();
+    } else {
+        failed = 1;
+        snprintf(msg, sizeof msg, "%s", c.message);
+    }
+    const int who = lub_par_first(failed);
+    if (who >= 0) {
+        lub_par_bcast_text(msg, sizeof msg, who);
+        lub_fatal("%s", msg);
+    }
+    lub_par_assemble(&S, place, info.n, &r->P, path);
+    lub_particles_free(&S);
+    free(place);
+}
+
 void lubfoam_read_start(lubfoam_run *r)
 {
     const lub_control *c = &r->ctl;
@@ -95,7 +131,11 @@ void lubfoam_read_start(lubfoam_run *r)
     }
     snprintf(r->start_name, sizeof r->start_name, "%s", name);
     if (c->start_from == LUB_START_STARTTIME) warn_earlier_results(&r->cs, name);
-    lub_particles_read(&r->P, lub_case_pathf(&r->cs, path, "%s/particles.h5", name));
+    lub_case_pathf(&r->cs, path, "%s/particles.h5", name);
+    if (lub_par_started())
+        read_start_parallel(r, path);
+    else
+        lub_particles_read(&r->P, path);
     r->t = r->P.time;
     r->step = r->P.step;
     r->dt = c->delta_t;
@@ -148,19 +188,31 @@ static void write_state(const lubfoam_run *r, const char *dir)
 
 void lubfoam_output_init(lubfoam_run *r)
 {
+    if (r->collective) { /* every rank: the buffers of its rows */
+        const size_t rows =
+            lub_par_row_first(&r->par, r->par.rank + 1) - lub_par_row_first(&r->par, r->par.rank);
+        lub_particles_writer_init(&r->writer, rows);
+        lub_particles_init(&r->R, r->P.dim, rows ? rows : 1);
+        r->R.nextra = 0;
+        r->place = lub_malloc((rows ? rows : 1) * sizeof *r->place);
+    }
     if (!lubfoam_writer_rank(r)) return;
     lub_case_clean(&r->cs);
-    lub_particles_writer_init(&r->writer, r->parallel ? r->par.ntotal : r->P.cap);
+    if (!r->collective)
+        lub_particles_writer_init(&r->writer, r->parallel ? r->par.ntotal : r->P.cap);
     r->writer.sync_dir = 0; /* into temporary time folders, synced by lub_timedir_commit */
     lub_xdmf_series_scan(&r->series, &r->cs);
 }
 
 void lubfoam_output_free(lubfoam_run *r)
 {
+    if (r->collective || lubfoam_writer_rank(r)) lub_particles_writer_free(&r->writer);
     if (!lubfoam_writer_rank(r)) return;
-    lub_particles_writer_free(&r->writer);
     lub_xdmf_series_free(&r->series);
 }
+
+static void finish_write(lubfoam_run *r, lubfoam_functions *fos, const char *name, const char *dir,
+                         const lub_particles *W);
 
 void lubfoam_write(lubfoam_run *r, lubfoam_functions *fos)
 {
@@ -168,9 +220,23 @@ void lubfoam_write(lubfoam_run *r, lubfoam_functions *fos)
     lub_time_name(r->t, r->ctl.time_precision, name, sizeof name);
     r->P.time = r->t;
     r->P.step = r->step;
-    /* -parallel: every rank's particles to rank 0, which writes the file a serial run
+    /* -parallel: every rank's particles to the rank writing their rows, and the file written
+     * collectively; or every rank's particles to rank 0, which writes the file a serial run
      * writes (the writer puts them in id order) */
     const lub_particles *W = &r->P;
+    if (r->collective) {
+        const size_t first = lub_par_rows(&r->par, &r->P, &r->R, r->place);
+        dir[0] = '\0';
+        if (lubfoam_writer_rank(r)) lub_timedir_begin(&r->cs, name, dir);
+        lub_par_bcast_text(dir, sizeof dir, 0);
+        /* (the file's time is the output phase's, not the communication's of the cost) */
+        lub_particles_writer_write_rows(&r->writer, &r->R, r->place, first, r->par.ntotal, dir);
+        if (!lubfoam_writer_rank(r)) return;
+        lub_particles H = r->R; /* the file's header and size, for the index */
+        H.n = r->par.ntotal;
+        finish_write(r, fos, name, dir, &H);
+        return;
+    }
     if (r->parallel) {
         if (r->G.cap == 0 && r->par.rank == 0) {
             lub_particles_init(&r->G, r->P.dim, r->par.ntotal);
@@ -182,6 +248,14 @@ void lubfoam_write(lubfoam_run *r, lubfoam_functions *fos)
     if (!lubfoam_writer_rank(r)) return;
     lub_timedir_begin(&r->cs, name, dir);
     lub_particles_writer_write(&r->writer, W, dir);
+    finish_write(r, fos, name, dir, W);
+}
+
+/* Rank 0, after the particle file: the rest of the time folder, its commit, the index and
+ * the purge. */
+static void finish_write(lubfoam_run *r, lubfoam_functions *fos, const char *name, const char *dir,
+                         const lub_particles *W)
+{
     write_state(r, dir);
     lubfoam_functions_write_state(fos, r, dir);
     lub_timedir_commit(&r->cs, name, dir);

@@ -4,6 +4,7 @@
  * on all of them (the models' start-up checks see the whole case); then each keeps the
  * particles of its slab (system/decomposeParDict.yaml) and the steps run on the slabs.
  * What is not parallel yet is refused here, before anything is written, naming it. */
+#include <stdlib.h>
 #include <string.h>
 
 #include "core/error.h"
@@ -90,6 +91,20 @@ void lubfoam_parallel_setup(lubfoam_run *r, const lub_geometry *geo, const lubfo
                 "(mean %.0f), halo width %g m%s%s",
                 size, "xyz"[axis], ax < 0 ? "auto: the fluid's longest" : "given", total, most,
                 (double)total / size, r->par.width, size > 1 ? ", cuts at " : "", cuts);
+    /* the particle files: collective when the build's HDF5 is Open MPI's and the ids are
+     * the rows (0 .. N-1, as particleGen numbers them), else gathered to rank 0 */
+    const int dense = lub_par_ids_dense(&r->par, &r->P);
+    r->collective = pd.write != LUB_PAR_WRITE_GATHER && lub_particles_collective() && dense;
+    if (pd.write == LUB_PAR_WRITE_COLLECTIVE && !dense)
+        lub_warning("%s: writeParticles collective, but the particles' ids are not 0 .. %zu "
+                    "(the rows of a particle file): gathered to rank 0 instead",
+                    path, total - 1);
+    lub_message("Particle files: %s",
+                r->collective ? "written collectively (MPI-IO: every rank its rows)"
+                : pd.write == LUB_PAR_WRITE_GATHER ? "gathered to rank 0 (writeParticles: gather)"
+                : !lub_particles_collective()
+                    ? "gathered to rank 0 (this build has the serial HDF5)"
+                    : "gathered to rank 0 (the ids are not 0 .. N-1)");
 }
 
 void lubfoam_parallel_free(lubfoam_run *r)
@@ -97,4 +112,6 @@ void lubfoam_parallel_free(lubfoam_run *r)
     if (!r->parallel) return;
     lub_par_free(&r->par);
     if (r->G.cap) lub_particles_free(&r->G);
+    if (r->R.cap) lub_particles_free(&r->R);
+    free(r->place);
 }
