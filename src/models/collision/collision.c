@@ -27,13 +27,37 @@ lub_collision lub_collision_defaults(void)
  * a square is sqrt(2)/2 l0 from its four corners and, coming along the normal, meets them
  * only at 0.37 l0 from the plane and almost edge-on, so the pairs let it through the holes
  * (tutorials/wedge3D at h0/4: a particle of the film crept into a hole of the roller's wall
- * over 0.5 ms and went through at step 536).  The plane closes them.
+ * over 0.5 ms and went through at step 536).  The plane closes them.  Only where the wall is
+ * a plane within re (planar): at a patch's edge the fitted plane cuts the corner (a box
+ * tank's particles stopped there kept the 3-D hydrostatic tank from settling).
  *
  * Each particle's change is computed from the velocities before the collision step, so the
  * result does not depend on the order or the number of threads.  The pairs are those of the
  * lists at r* (lub_collision_apply makes them complete), at the current positions. */
-#define PLANE_GATE   1.2 /* l0: a fluid particle this close to a wall particle is tested */
-#define PLANE_MAXPAT 4   /* the patches tested per particle (a corner: two or three) */
+#define PLANE_GATE 1.2  /* l0: a fluid particle this close to a wall particle is tested */
+#define PLANE_FLAT 0.25 /* l0: the most a wall particle may stand off the plane */
+
+/* Whether the wall particles of patch `patch` within re of i lie on the plane (cw, n) within
+ * PLANE_FLAT l0: not where two faces of a patch meet (a box tank's edge, a roller's end),
+ * whose least-squares plane runs across the corner, nor on a wall curved within re (a body of
+ * a few l0 in radius). */
+static int planar(const lub_mps *m, size_t i, unsigned patch, const double cw[3], const double n[3])
+{
+    const lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    double *const x[3] = {P->x[0], P->x[1], P->x[2]};
+    const double re2 = m->re * m->re, tol = PLANE_FLAT * m->l0;
+    for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+        const size_t j = nb->j[q];
+        if (P->kind[j] != LUB_WALL || P->patch[j] != patch) continue;
+        double v[3];
+        if (!(lub_neighbours_r(nb, x, i, j, v) < re2)) continue;
+        const double t = (v[0] - cw[0]) * n[0] + (v[1] - cw[1]) * n[1] + (v[2] - cw[2]) * n[2];
+        if (fabs(t) > tol) return 0;
+    }
+    return 1;
+}
+#define PLANE_MAXPAT 4 /* the patches tested per particle (a corner: two or three) */
 static void collide(const lub_collision *c, lub_mps *m, double dt, size_t *nplane)
 {
     lub_particles *P = m->P;
@@ -84,7 +108,7 @@ static void collide(const lub_collision *c, lub_mps *m, double dt, size_t *nplan
                 if (!lub_mps_wall_plane(m, i, pat[k], cw, nw)) continue;
                 /* cw: the wall particles' centroid from i; nw: the normal into the fluid */
                 const double s = -(cw[0] * nw[0] + cw[1] * nw[1] + cw[2] * nw[2]);
-                if (!(s < dw)) continue;
+                if (!(s < dw) || !planar(m, i, pat[k], cw, nw)) continue;
                 const size_t w = wnear[k];
                 double vn = 0;
                 for (int d = 0; d < dim; d++) vn += (P->u[d][i] + acc[d] - P->u[d][w]) * nw[d];
