@@ -30,8 +30,10 @@
  * their force too, so that a body turns with its wetting.  Kernels: w^a = (r/h)(1 -
  * r/h)^2 / (S_a h^d), S_a = pi/(15 l0^d); w^g the MPH kernel (models/fluid/mph.h);
  * h = h_s = 3.5 l0; R2 = h^2/10 (2-D), 2 h^2/21 (3-D); k = 0.350778153 (2-D), 0.326976006
- * (3-D); a = sigma / (h_s (I_N + k^2 I_X)), I_N = 0.024679383, I_X = 0.226126699 (2-D),
- * 0.021425779, 0.233977488 (3-D): Kondo's flat-interface calibration [KC].
+ * (3-D).  a: the model's flat interface on the lattice pulls sigma (its mechanical tension,
+ * flat_interface); Kondo's codes [KC] calibrate to its energy instead, a_E = sigma / (h_s
+ * (I_N + k^2 I_X)), I_N = 0.024679383, I_X = 0.226126699 (2-D), 0.021425779, 0.233977488
+ * (3-D), which pulls 1.037 sigma (2-D), 0.977 sigma (3-D) on the lattice (methods.md 9).
  *
  * The wall factor c(theta): Young-Dupre's (1 + cos theta)/2 for pairwise-additive energies
  * does not hold (CPP is quadratic in the density deficit); c is interpolated in the table
@@ -134,7 +136,9 @@ static void flat_interface(const surface *S, double *tension, double *energy)
 {
     const int dim = S->dim, h = (int)ceil(HS), hz = dim == 3 ? h : 0, nrow = 3 * h;
     const double l0 = S->l0, hs = S->hs, ch = hs / S->R2;
-    double N[3 * (int)(HS + 1)], chi[3 * (int)(HS + 1)];
+    double N[12], chi[12]; /* 3 ceil(h_s/l0) rows: a row deeper than 2 h_s has no pair with
+                              one that differs from the bulk */
+    if (nrow > 12) lub_bug("surfaceTension: %d rows for the flat interface, 12 kept", nrow);
     for (int q = 0; q < nrow; q++) { /* row at y = -q l0: its neighbours at y' <= 0 */
         double n = 0, cy = 0;
         for (int x = -h; x <= h; x++)
