@@ -500,11 +500,11 @@ static void st_header(const lub_model *m, const lub_scene *s)
                    : (size_t)snprintf(walls + len, sizeof walls - len, "%s%s %g deg (c %.4g)",
                                       len ? ", " : "", s->P->patch_names[p], S->theta[p], S->c[p]);
     lub_message("surfaceTension: CPP + DGP (methods.md 9), sigma %g N/m, h_s %g m (3.5 l0), "
-                "a %.6g Pa (the flat lattice interface pulls sigma, its energy %.4f sigma; "
-                "Kondo's energy calibration %.6g Pa would pull %.4f sigma), k %.9g, n0^a %.10g; "
+                "a %.6g Pa, k %.9g, n0^a %.10g; a: the flat lattice interface pulls sigma, its "
+                "energy %.4f sigma (Kondo's energy calibration %.6g Pa would pull %.4f sigma); "
                 "walls: %s (c from the sessile-drop table)",
-                S->sigma, S->hs, S->a, S->energy1 / S->tension1, S->a_energy,
-                S->a_energy * S->tension1 / S->sigma, S->k, S->n0a, len ? walls : "none");
+                S->sigma, S->hs, S->a, S->k, S->n0a, S->energy1 / S->tension1, S->a_energy,
+                S->a_energy * S->tension1 / S->sigma, len ? walls : "none");
 }
 
 static void st_free(lub_model *m)
