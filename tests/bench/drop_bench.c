@@ -7,21 +7,23 @@
  *                                               as the force across two cuts (mechanical),
  *                                               against sigma / R (2-D), 2 sigma / R (3-D)
  *     build/bench/drop_bench oscillate DIM R0   the drop set moving in mode 2; the period of
- *                                               <x^2> - <y^2> against Rayleigh's, the decay
- *                                               rate against Lamb's
+ *                                               <x^2> - <y^2> (about the settled drop's own;
+ *                                               LUB_NO_OFFSET=1: about 0) against Rayleigh's,
+ *                                               the decay rate against Lamb's
  *     build/bench/drop_bench slab DIM T         a slab T l0 thick, periodic across (LUB_WIDTH
  *                                               l0, 20): its tension (the force across a
  *                                               normal cut) and energy per area
  *
  * l0 = 0.1 mm, rho 1000; environment: LUB_STEPS (steps of LUB_DT, 2e-5 s), LUB_NU (1e-4),
  * LUB_KAPPA (3e3), LUB_LAMBDA (1), LUB_SIGMA (0.03), LUB_AMP (the mode-2 amplitude eps, 0.1),
- * LUB_RELAX (steps with nu 1e-4, lambda 1 before the mode is set moving), LUB_EVERY (steps
+ * LUB_RELAX (steps with nu 1e-4, lambda 1 before the mode is set moving, after the annealing
+ * if any; an oscillating drop is annealed with these viscosities too), LUB_EVERY (steps
  * between printed lines, 100), LUB_PACK=rings (2-D: concentric rings l0 apart instead of the
  * lattice disc), LUB_ANNEAL=N (N steps of random velocity kicks first, their standard
- * deviation LUB_NOISE m/s, 0.01, falling to 0), LUB_DUMP=FILE (laplace: x, y, P, the virial
- * pressure of each particle at the end, in l0 and dp).  The laplace drop's inside pressure
- * is read three ways: the mean P of (K-7a), the force across the two cuts, and the virial
- * (the trace of the pair forces' stress) of the interior particles; at the end a radial
+ * deviation LUB_NOISE m/s, 0.01, falling to 0; LUB_SEED seeds them, 12345), LUB_DUMP=FILE (laplace:
+ * x, y, P, the virial pressure of each particle at the end, in l0 and dp).  The laplace drop's
+ * inside pressure is read three ways: the mean P of (K-7a), the force across the two cuts, and the
+ * virial (the trace of the pair forces' stress) of the interior particles; at the end a radial
  * profile.  The pair sums are over all pairs: slow beyond a few thousand particles.
  */
 #include <math.h>
@@ -75,9 +77,35 @@ static double k_dwa(int dim, double l0, double h, double r)
 
 typedef struct {
     double a, k, ch, n0a, hs, l0;
+    double a_energy; /* Kondo's a [KC]: the continuum interface's energy sigma */
     int dim;
     double Lx;
 } stmodel;
+
+static void cut_stress(const stmodel *M, const lub_particles *P, int ax, int tg, double xc,
+                       const double centre[3], double rc, double out[3]);
+
+/* The model's coefficient a (methods.md §9), found here again: the flat interface of a
+ * lattice slab (16 rows, periodic over 10 l0 across) pulls sigma, its tension per unit a
+ * from the force across a cut normal to it (cut_stress). */
+static double st_calibrate(stmodel *M, double sigma)
+{
+    lub_particles S;
+    lub_particles_init(&S, M->dim, 1);
+    for (int a = 0; a < 10; a++)
+        for (int b = 0; b < 16; b++)
+            for (int c = 0; c < (M->dim == 3 ? 10 : 1); c++) {
+                const double x[3] = {a * M->l0, b * M->l0, c * M->l0};
+                lub_particles_add(&S, x, LUB_FLUID, 0, 0);
+            }
+    const double Lx = M->Lx, ctr[3] = {0, 0, 0};
+    double o[3];
+    M->Lx = 10 * M->l0, M->a = 1.0;
+    cut_stress(M, &S, 0, 1, 4.5 * M->l0, ctr, 0, o);
+    M->Lx = Lx;
+    lub_particles_free(&S);
+    return sigma / (-0.5 * o[0]);
+}
 
 static void st_setup(stmodel *M, int dim, double l0, double sigma, double Lx)
 {
@@ -85,7 +113,7 @@ static void st_setup(stmodel *M, int dim, double l0, double sigma, double Lx)
     M->k = dim == 2 ? 0.350778153 : 0.326976006;
     const double IN = dim == 2 ? 0.024679383 : 0.021425779;
     const double IX = dim == 2 ? 0.226126699 : 0.233977488;
-    M->a = sigma / (M->hs * (IN + M->k * M->k * IX));
+    M->a_energy = sigma / (M->hs * (IN + M->k * M->k * IX));
     const double R2 = dim == 2 ? M->hs * M->hs / 10.0 : 2.0 * M->hs * M->hs / 21.0;
     M->ch = M->hs / R2;
     M->n0a = 0;
@@ -96,6 +124,7 @@ static void st_setup(stmodel *M, int dim, double l0, double sigma, double Lx)
                 const double r = l0 * sqrt((double)(x * x + y * y + z * z));
                 if (r > 0) M->n0a += k_wa(dim, l0, M->hs, r);
             }
+    M->a = st_calibrate(M, sigma);
 }
 
 static double sep(const stmodel *M, const lub_particles *P, size_t i, size_t j, double r[3])
@@ -362,25 +391,13 @@ int main(int argc, char **argv)
     const double rin = fmax(R - 2 * 3.5 * l0, 0.5 * R);
     const double omega2 = (dim == 2 ? 6.0 : 8.0) * sigma / (rho * R * R * R);
     const double T = 2 * M_PI / sqrt(omega2);
-    /* LUB_RELAX steps first with nu 1e-4, lambda 1 Pa s: the drop settles from the lattice
-     * disc before the mode is set moving (the oscillation about equilibrium) */
-    const long nrelax = (long)env("LUB_RELAX", 0);
-    if (nrelax > 0) {
-        m.c.nu = 1e-4, m.c.bulk_viscosity = 1.0;
-        char rmsg[512];
-        long rbad;
-        for (long k = 0; k < nrelax; k++)
-            if (lub_mph_step(&m, dt, &rbad, rmsg, sizeof rmsg) != LUB_STEP_OK) {
-                printf("relaxation step %ld failed: %s\n", k, rmsg);
-                return 1;
-            }
-        m.c.nu = nu, m.c.bulk_viscosity = lambda;
-    }
     /* LUB_ANNEAL=N steps with random velocity kicks (zero mean, standard deviation LUB_NOISE
      * m/s per step falling linearly to 0): the drop shaken out of its first packing */
     const long nanneal = (long)env("LUB_ANNEAL", 0);
     const double noise = env("LUB_NOISE", 0.01);
-    srand(12345);
+    srand((unsigned)env("LUB_SEED", 12345));
+    if (osc && nanneal > 0) /* annealed with the relaxation's viscosities, as it settles */
+        m.c.nu = 1e-4, m.c.bulk_viscosity = 1.0;
     for (long k = 0; k < nanneal; k++) {
         const double s = noise * (1.0 - (double)k / nanneal);
         double mean[3] = {0, 0, 0};
@@ -393,8 +410,42 @@ int main(int argc, char **argv)
             }
         for (size_t i = 0; i < P.n; i++)
             for (int q = 0; q < dim; q++) P.u[q][i] -= mean[q];
-        /* and their rigid rotation (2-D: about the centroid), which no viscosity would damp:
-         * a spinning drop's centrifugal pressure would add to its Laplace pressure */
+        /* and their rigid rotation (about the centroid), which no viscosity would damp: a
+         * spinning drop's centrifugal pressure would add to its Laplace pressure */
+        if (dim == 3) { /* omega = I^-1 L, u -= omega x r */
+            double cx[3] = {0, 0, 0}, L[3] = {0, 0, 0}, I[3][3] = {{0}};
+            for (size_t i = 0; i < P.n; i++)
+                for (int q = 0; q < 3; q++) cx[q] += P.x[q][i] / P.n;
+            for (size_t i = 0; i < P.n; i++) {
+                const double r[3] = {P.x[0][i] - cx[0], P.x[1][i] - cx[1], P.x[2][i] - cx[2]};
+                const double *u[3] = {&P.u[0][i], &P.u[1][i], &P.u[2][i]};
+                L[0] += r[1] * *u[2] - r[2] * *u[1], L[1] += r[2] * *u[0] - r[0] * *u[2];
+                L[2] += r[0] * *u[1] - r[1] * *u[0];
+                const double rr = r[0] * r[0] + r[1] * r[1] + r[2] * r[2];
+                for (int p = 0; p < 3; p++)
+                    for (int q = 0; q < 3; q++) I[p][q] += (p == q ? rr : 0.0) - r[p] * r[q];
+            }
+            /* I w = L by Cramer's rule (I symmetric positive definite) */
+            const double det = I[0][0] * (I[1][1] * I[2][2] - I[1][2] * I[2][1]) -
+                               I[0][1] * (I[1][0] * I[2][2] - I[1][2] * I[2][0]) +
+                               I[0][2] * (I[1][0] * I[2][1] - I[1][1] * I[2][0]);
+            double w[3];
+            for (int c = 0; c < 3; c++) {
+                double A[3][3];
+                for (int p = 0; p < 3; p++)
+                    for (int q = 0; q < 3; q++) A[p][q] = q == c ? L[p] : I[p][q];
+                w[c] = (A[0][0] * (A[1][1] * A[2][2] - A[1][2] * A[2][1]) -
+                        A[0][1] * (A[1][0] * A[2][2] - A[1][2] * A[2][0]) +
+                        A[0][2] * (A[1][0] * A[2][1] - A[1][1] * A[2][0])) /
+                       det;
+            }
+            for (size_t i = 0; i < P.n; i++) {
+                const double r[3] = {P.x[0][i] - cx[0], P.x[1][i] - cx[1], P.x[2][i] - cx[2]};
+                P.u[0][i] -= w[1] * r[2] - w[2] * r[1];
+                P.u[1][i] -= w[2] * r[0] - w[0] * r[2];
+                P.u[2][i] -= w[0] * r[1] - w[1] * r[0];
+            }
+        }
         if (dim == 2) {
             double cx[2] = {0, 0}, L = 0, I = 0;
             for (size_t i = 0; i < P.n; i++) cx[0] += P.x[0][i] / P.n, cx[1] += P.x[1][i] / P.n;
@@ -414,10 +465,36 @@ int main(int argc, char **argv)
             return 1;
         }
     }
+    m.c.nu = nu, m.c.bulk_viscosity = lambda;
+    /* LUB_RELAX steps with nu 1e-4, lambda 1 Pa s (after the annealing, if any): the drop
+     * settles before the mode is set moving (the oscillation about equilibrium) */
+    const long nrelax = (long)env("LUB_RELAX", 0);
+    if (nrelax > 0) {
+        m.c.nu = 1e-4, m.c.bulk_viscosity = 1.0;
+        char rmsg[512];
+        long rbad;
+        for (long k = 0; k < nrelax; k++)
+            if (lub_mph_step(&m, dt, &rbad, rmsg, sizeof rmsg) != LUB_STEP_OK) {
+                printf("relaxation step %ld failed: %s\n", k, rmsg);
+                return 1;
+            }
+        m.c.nu = nu, m.c.bulk_viscosity = lambda;
+    }
+    /* the settled drop's own <x^2> - <y^2> (a jammed packing is not quite round): the
+     * oscillation is measured about it, or its crossings alternate unevenly and the extremes
+     * of one side stand higher than the other's as the amplitude decays */
+    double D0 = 0;
     if (osc) { /* the velocity of mode 2 at its equilibrium crossing: u = eps omega (x, -y) */
         const double v = amp * sqrt(omega2);
         double cx[2] = {0, 0};
         for (size_t i = 0; i < P.n; i++) cx[0] += P.x[0][i] / P.n, cx[1] += P.x[1][i] / P.n;
+        for (size_t i = 0; i < P.n; i++)
+            D0 += ((P.x[0][i] - cx[0]) * (P.x[0][i] - cx[0]) -
+                   (P.x[1][i] - cx[1]) * (P.x[1][i] - cx[1])) /
+                  P.n;
+        if (getenv("LUB_NO_OFFSET")) D0 = 0;
+        printf("the settled drop's <x^2> - <y^2>: %.4g l0^2 (the oscillation measured about it)\n",
+               D0 / (l0 * l0));
         for (size_t i = 0; i < P.n; i++) {
             P.u[0][i] = v * (P.x[0][i] - cx[0]);
             P.u[1][i] = -v * (P.x[1][i] - cx[1]);
@@ -434,7 +511,10 @@ int main(int argc, char **argv)
         double o[3];
         const double ctr[3] = {0, 0, 0};
         cut_stress(&M, &P, 0, 1, 0.5 * l0 * (W / 2 - 0.5) + 0.25 * l0 * 0, ctr, 0, o);
-        printf("lattice slab: tension %.5g N/m = %.4f sigma\n", -0.5 * o[0], -0.5 * o[0] / sigma);
+        printf("lattice slab: tension %.5g N/m = %.4f sigma (a %.6g Pa; Kondo's energy "
+               "calibration, a %.6g Pa, would pull %.4f sigma)\n",
+               -0.5 * o[0], -0.5 * o[0] / sigma, M.a, M.a_energy,
+               -0.5 * o[0] / sigma * M.a_energy / M.a);
         double Vs, Ve;
         energies(&M, &P, kappa, &Vs, &Ve);
         const double area = dim == 2 ? 2 * W * l0 : 2 * W * W * l0 * l0;
@@ -457,7 +537,7 @@ int main(int argc, char **argv)
                 sx += (P.x[0][i] - cx[0]) * (P.x[0][i] - cx[0]) / P.n;
                 sy += (P.x[1][i] - cx[1]) * (P.x[1][i] - cx[1]) / P.n;
             }
-            const double D = sx - sy;
+            const double D = sx - sy - D0;
             if (fabs(D) > fabs(dext)) dext = D;
             if (k > 1 && (D > 0) != (Dprev > 0) && ncross < 64) {
                 tcross[ncross] = (k - 1 + Dprev / (Dprev - D)) * dt;

@@ -30,8 +30,10 @@
  * their force too, so that a body turns with its wetting.  Kernels: w^a = (r/h)(1 -
  * r/h)^2 / (S_a h^d), S_a = pi/(15 l0^d); w^g the MPH kernel (models/fluid/mph.h);
  * h = h_s = 3.5 l0; R2 = h^2/10 (2-D), 2 h^2/21 (3-D); k = 0.350778153 (2-D), 0.326976006
- * (3-D); a = sigma / (h_s (I_N + k^2 I_X)), I_N = 0.024679383, I_X = 0.226126699 (2-D),
- * 0.021425779, 0.233977488 (3-D): Kondo's flat-interface calibration [KC].
+ * (3-D).  a: the model's flat interface on the lattice pulls sigma (its mechanical tension,
+ * flat_interface); Kondo's codes [KC] calibrate to its energy instead, a_E = sigma / (h_s
+ * (I_N + k^2 I_X)), I_N = 0.024679383, I_X = 0.226126699 (2-D), 0.021425779, 0.233977488
+ * (3-D), which pulls 1.037 sigma (2-D), 0.977 sigma (3-D) on the lattice (methods.md 9).
  *
  * The wall factor c(theta): Young-Dupre's (1 + cos theta)/2 for pairwise-additive energies
  * does not hold (CPP is quadratic in the density deficit); c is interpolated in the table
@@ -66,6 +68,8 @@ typedef struct {
     double c[LUB_MAX_PATCHES];     /* wall factor per patch */
     int dim;
     double l0, hs, a, k, R2, n0a;
+    double a_energy;          /* Kondo's a [KC]: the continuum interface's energy sigma */
+    double tension1, energy1; /* the flat lattice interface's tension and energy per unit a */
     size_t cap;
     double *na, *chi[3];
     double *pc;            /* the particle field pCohesive: a N_i, the cohesive (CPP) pressure */
@@ -97,6 +101,76 @@ static double pair(const lub_neighbours *nb, size_t q, int dim, double e[3])
     const double r = sqrt(r2);
     for (int d = 0; d < 3; d++) e[d] = d < dim && r > 0 ? nb->dx[d][q] / r : 0.0;
     return r;
+}
+
+/* The pair term of (K-8) on particle a from j, per unit a and per dA (the force on a is a dA
+ * times the sum of these): c (N_a + N_j) e w^a' (CPP) - c k^2 (h_s/R2) M_aj (chi_j - chi_a)
+ * (DGP, M v = w^g v + (v.r) e w^g'), chi_* already scaled by h_s/R2; dx = x_j - x_a, r = |dx|,
+ * e = dx/r.  Antisymmetric in a, j. */
+static void pair_force(const surface *S, double c, double Na, double Nj, const double cha[3],
+                       const double chj[3], const double dx[3], double r, const double e[3],
+                       double out[3])
+{
+    const int dim = S->dim;
+    const double l0 = S->l0, hs = S->hs, k2ch = S->k * S->k * S->hs / S->R2;
+    const double cpp = c * (Na + Nj) * dwa(dim, l0, hs, r);
+    double v[3] = {0, 0, 0}, vr = 0;
+    for (int d = 0; d < dim; d++) {
+        v[d] = chj[d] - cha[d];
+        vr += v[d] * dx[d];
+    }
+    const double wg = lub_mph_w(dim, l0, hs, r), dwg = lub_mph_dw(dim, l0, hs, r);
+    for (int d = 0; d < 3; d++)
+        out[d] = d < dim ? cpp * e[d] - k2ch * c * (wg * v[d] + vr * e[d] * dwg) : 0.0;
+}
+
+/* The flat interface of the fluid on its lattice (the rows y = 0, -l0, -2 l0, ... below it,
+ * unbounded along x (and z)), per unit a: its mechanical tension (the pull across a cut
+ * normal to it; Irving-Kirkwood) and its energy, per length (2-D) or area (3-D), returned as
+ * *tension and *energy.  Each row at depth q l0 has its own N_q and chi_q (along y only);
+ * rows deeper than h_s have the bulk's N = 0, chi = 0.  The force across the plane x = const
+ * per length of it: each pair of offset r_x > 0 crosses it r_x / l0 times per column, so with
+ * one column of particles i, tension = sum_i sum_j r_x f_x(on i from j) / (2 l0^(d-1))
+ * (both signs of r_x: the 1/2).  Energy: the (K-7b) potential of one column per l0^(d-1). */
+static void flat_interface(const surface *S, double *tension, double *energy)
+{
+    const int dim = S->dim, h = (int)ceil(HS), hz = dim == 3 ? h : 0, nrow = 3 * h;
+    const double l0 = S->l0, hs = S->hs, ch = hs / S->R2;
+    double N[12], chi[12]; /* 3 ceil(h_s/l0) rows: a row deeper than 2 h_s has no pair with
+                              one that differs from the bulk */
+    if (nrow > 12) lub_bug("surfaceTension: %d rows for the flat interface, 12 kept", nrow);
+    for (int q = 0; q < nrow; q++) { /* row at y = -q l0: its neighbours at y' <= 0 */
+        double n = 0, cy = 0;
+        for (int x = -h; x <= h; x++)
+            for (int y = -h; y <= h; y++)
+                for (int z = -hz; z <= hz; z++) {
+                    const double r = l0 * sqrt((double)(x * x + y * y + z * z));
+                    if (r == 0 || !(r < hs) || y > q) continue; /* y' = -q + y above the top */
+                    n += wa(dim, l0, hs, r);
+                    cy += ch * y * l0 * lub_mph_w(dim, l0, hs, r);
+                }
+        N[q] = fmin(n - S->n0a, 0.0), chi[q] = cy;
+    }
+    const double dA = dim == 2 ? l0 * l0 : l0 * l0 * l0, per = dim == 2 ? l0 : l0 * l0;
+    double T = 0, E = 0;
+    for (int q = 0; q < 2 * h; q++) { /* deeper pairs carry nothing: N = chi = 0 on both */
+        const double cq[3] = {0, chi[q], 0};
+        E += 0.5 * (N[q] * N[q] + S->k * S->k * chi[q] * chi[q]) * dA / per;
+        for (int x = -h; x <= h; x++)
+            for (int y = -h; y <= h; y++)
+                for (int z = -hz; z <= hz; z++) {
+                    const double r = l0 * sqrt((double)(x * x + y * y + z * z));
+                    if (r == 0 || !(r < hs) || y > q || x == 0) continue;
+                    const int qj = q - y;
+                    const double dx[3] = {x * l0, y * l0, z * l0};
+                    const double e[3] = {dx[0] / r, dx[1] / r, dx[2] / r};
+                    const double cj[3] = {0, qj < nrow ? chi[qj] : 0.0, 0};
+                    double f[3];
+                    pair_force(S, 1.0, N[q], qj < nrow ? N[qj] : 0.0, cq, cj, dx, r, e, f);
+                    T += dx[0] * f[0] * dA / (2 * per);
+                }
+    }
+    *tension = T, *energy = E;
 }
 
 /* The contact angle of a 2-D sessile drop against the wall factor c (doc/methods.md §9:
@@ -213,9 +287,6 @@ static void st_init(lub_model *m, lub_scene *s)
     const double l0 = S->l0;
     S->hs = HS * l0;
     S->k = dim == 2 ? 0.350778153 : 0.326976006;
-    const double IN = dim == 2 ? 0.024679383 : 0.021425779;
-    const double IX = dim == 2 ? 0.226126699 : 0.233977488;
-    S->a = S->sigma / (S->hs * (IN + S->k * S->k * IX));
     S->R2 = dim == 2 ? S->hs * S->hs / 10.0 : 2.0 * S->hs * S->hs / 21.0;
     /* n0^a on the lattice */
     const int h = (int)ceil(HS), hz = dim == 3 ? h : 0;
@@ -226,6 +297,16 @@ static void st_init(lub_model *m, lub_scene *s)
                 const double r = l0 * sqrt((double)(x * x + y * y + z * z));
                 if (r > 0) S->n0a += wa(dim, l0, S->hs, r);
             }
+    /* a: the flat interface on the lattice pulls sigma (its mechanical tension, the force
+     * across a cut normal to it).  Kondo's calibration [KC], a_E = sigma / (h_s (I_N + k^2
+     * I_X)), makes the energy of the continuum's interface sigma; the particles' interface,
+     * solid-like, has a surface stress that differs from its surface energy (Shuttleworth),
+     * and Laplace's and Young's laws and the bridge are force balances (methods.md 9). */
+    const double IN = dim == 2 ? 0.024679383 : 0.021425779;
+    const double IX = dim == 2 ? 0.226126699 : 0.233977488;
+    S->a_energy = S->sigma / (S->hs * (IN + S->k * S->k * IX));
+    flat_interface(S, &S->tension1, &S->energy1);
+    S->a = S->sigma / S->tension1;
     S->cap = s->P->cap > s->P->n ? s->P->cap : s->P->n;
     S->na = lub_calloc(S->cap ? S->cap : 1, sizeof(double));
     for (int d = 0; d < 3; d++) S->chi[d] = lub_calloc(S->cap ? S->cap : 1, sizeof(double));
@@ -345,7 +426,7 @@ static int st_particle_forces(lub_model *m, const lub_mps *f, double *const acc[
         for (int d = 0; d < dim; d++) S->chi[d][i] *= ch;
     }
     const double dA = dim == 2 ? l0 * l0 : l0 * l0 * l0;
-    const double inv_m = 1.0 / (f->c.rho * dA), ak2 = S->a * S->k * S->k * ch;
+    const double inv_m = 1.0 / (f->c.rho * dA);
     for (size_t a = 0; a < P->n; a++) {
         if (P->kind[a] != LUB_FLUID) continue;
         double F[3] = {0, 0, 0};
@@ -355,18 +436,15 @@ static int st_particle_forces(lub_model *m, const lub_mps *f, double *const acc[
             if (!(r < hs) || r == 0) continue;
             const size_t j = nb->j[q];
             const double c = P->kind[j] == LUB_FLUID ? 1.0 : S->c[P->patch[j]];
-            /* CPP: c (N_a + N_j) e w^a' */
-            const double cpp = S->a * c * (S->na[a] + S->na[j]) * dwa(dim, l0, hs, r);
-            /* DGP: c M_aj (chi_j - chi_a), M v = w v + (v.r) e w' */
-            double v[3] = {0, 0, 0}, vr = 0;
-            for (int d = 0; d < dim; d++) {
-                v[d] = S->chi[d][j] - S->chi[d][a];
-                vr += v[d] * nb->dx[d][q];
+            double dx[3], cha[3], chj[3], fp[3];
+            for (int d = 0; d < 3; d++) {
+                dx[d] = d < dim ? nb->dx[d][q] : 0.0;
+                cha[d] = d < dim ? S->chi[d][a] : 0.0, chj[d] = d < dim ? S->chi[d][j] : 0.0;
             }
-            const double wg = lub_mph_w(dim, l0, hs, r), dwg = lub_mph_dw(dim, l0, hs, r);
+            pair_force(S, c, S->na[a], S->na[j], cha, chj, dx, r, e, fp);
             const int wall = P->kind[j] != LUB_FLUID;
             for (int d = 0; d < dim; d++) {
-                const double fd = cpp * e[d] - ak2 * c * (wg * v[d] + vr * e[d] * dwg);
+                const double fd = S->a * fp[d];
                 F[d] += fd;
                 /* the pair term is antisymmetric (e and chi_j - chi_a change sign, M_aj is
                  * symmetric): the wall particle gets its reaction, in the same units (per
@@ -390,14 +468,13 @@ static int st_particle_forces(lub_model *m, const lub_mps *f, double *const acc[
             const double r = pair(nb, q, dim, e);
             const size_t j = nb->j[q];
             if (!(r < hs) || r == 0 || P->kind[j] == LUB_FLUID) continue;
-            const double cpp = S->a * (S->na[a] + S->na[j]) * dwa(dim, l0, hs, r);
-            double v[3] = {0, 0, 0}, vr = 0;
-            for (int d = 0; d < dim; d++) {
-                v[d] = S->chi[d][j] - S->chi[d][a];
-                vr += v[d] * nb->dx[d][q];
+            double dx[3], cha[3], chj[3], fp[3];
+            for (int d = 0; d < 3; d++) {
+                dx[d] = d < dim ? nb->dx[d][q] : 0.0;
+                cha[d] = d < dim ? S->chi[d][a] : 0.0, chj[d] = d < dim ? S->chi[d][j] : 0.0;
             }
-            const double wg = lub_mph_w(dim, l0, hs, r), dwg = lub_mph_dw(dim, l0, hs, r);
-            for (int d = 0; d < dim; d++) F[d] += cpp * e[d] - ak2 * (wg * v[d] + vr * e[d] * dwg);
+            pair_force(S, 1.0, S->na[a], S->na[j], cha, chj, dx, r, e, fp);
+            for (int d = 0; d < dim; d++) F[d] += S->a * fp[d];
         }
         for (int d = 0; d < dim; d++) acc[d][a] += F[d] * dA * inv_m;
     }
@@ -423,8 +500,11 @@ static void st_header(const lub_model *m, const lub_scene *s)
                    : (size_t)snprintf(walls + len, sizeof walls - len, "%s%s %g deg (c %.4g)",
                                       len ? ", " : "", s->P->patch_names[p], S->theta[p], S->c[p]);
     lub_message("surfaceTension: CPP + DGP (methods.md 9), sigma %g N/m, h_s %g m (3.5 l0), "
-                "a %.6g Pa, k %.9g, n0^a %.10g; walls: %s (c from the sessile-drop table)",
-                S->sigma, S->hs, S->a, S->k, S->n0a, len ? walls : "none");
+                "a %.6g Pa, k %.9g, n0^a %.10g; a: the flat lattice interface pulls sigma, its "
+                "energy %.4f sigma (Kondo's energy calibration %.6g Pa would pull %.4f sigma); "
+                "walls: %s (c from the sessile-drop table)",
+                S->sigma, S->hs, S->a, S->k, S->n0a, S->energy1 / S->tension1, S->a_energy,
+                S->a_energy * S->tension1 / S->sigma, len ? walls : "none");
 }
 
 static void st_free(lub_model *m)
