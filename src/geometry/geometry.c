@@ -569,14 +569,16 @@ void lub_wall_translate(lub_wall *w, const lub_wall *w0, const double *d)
 
 /* ---- wall functions ------------------------------------------------------------------- */
 
-/* Heights y where the line (x, y, 0) crosses the round surface of a circle (2-D), a 3-D
- * cylinder or a sphere: the roots of |perp(d)|^2 = R^2, d = (x, y, 0) - centre.  Returns 0
- * when the line misses the surface (or runs along a vertical axis). */
-static int round_roots(const lub_wall *w, double x, double *ylo, double *yhi)
+/* Heights y where the line (x, y, z) crosses the round surface of a circle (2-D: z = 0), a
+ * 3-D cylinder or a sphere: the roots of |perp(d)|^2 = R^2, d = (x, y, z) - centre.  Returns
+ * 0 when the line misses the surface (or runs along a vertical axis). */
+static int round_roots(const lub_wall *w, double x, double z, double *ylo, double *yhi)
 {
-    double d0[3] = {x - w->centre[0], -w->centre[1], -w->centre[2]};
+    double d0[3] = {x - w->centre[0], -w->centre[1], z - w->centre[2]};
     double ey[3] = {0, 1, 0};
-    if (w->type == LUB_WALL_CYLINDER && (w->axis[0] != 0 || w->axis[1] != 0 || w->axis[2] != 0)) {
+    int axis = w->axis[0] != 0 || w->axis[1] != 0 || w->axis[2] != 0;
+    if (w->type == LUB_WALL_CYLINDER && !axis) d0[2] = 0.0; /* a 2-D circle: extruded in z */
+    if (w->type == LUB_WALL_CYLINDER && axis) {
         /* 3-D cylinder: remove the axial components */
         double a0 = dot3(d0, w->axis), ay = w->axis[1];
         for (int d = 0; d < 3; d++) {
@@ -593,7 +595,7 @@ static int round_roots(const lub_wall *w, double x, double *ylo, double *yhi)
     *yhi = (-B + s) / (2.0 * A);
     if (w->type == LUB_WALL_CYLINDER && w->has_length) {
         /* a roller of finite length: the line must meet its round surface between the ends */
-        const double c[3] = {x - w->centre[0], -w->centre[1], -w->centre[2]};
+        const double c[3] = {x - w->centre[0], -w->centre[1], z - w->centre[2]};
         for (int k = 0; k < 2; k++) {
             double y = k ? *yhi : *ylo, q[3] = {c[0], c[1] + y, c[2]};
             if (fabs(dot3(q, w->axis)) > 0.5 * w->length * (1 + 1e-12)) return 0;
@@ -614,13 +616,18 @@ static double polyline_at(const lub_wall *w, double x)
 
 int lub_wall_height(const lub_wall *w, double x, int upper, double *y)
 {
+    return lub_wall_height_at(w, x, 0.0, upper, y);
+}
+
+int lub_wall_height_at(const lub_wall *w, double x, double z, int upper, double *y)
+{
     if (w->has_range && (x < w->range[0] || x > w->range[1])) return 0;
     switch (w->type) {
     case LUB_WALL_PLANE: {
         if (fabs(w->normal[1]) < 1e-12) return 0; /* vertical: no height */
-        /* n . ((x, y, 0) - p) = 0 */
+        /* n . ((x, y, z) - p) = 0 */
         *y = w->point[1] -
-             (w->normal[0] * (x - w->point[0]) - w->normal[2] * w->point[2]) / w->normal[1];
+             (w->normal[0] * (x - w->point[0]) + w->normal[2] * (z - w->point[2])) / w->normal[1];
         return 1;
     }
     case LUB_WALL_SEGMENT: {
@@ -636,7 +643,7 @@ int lub_wall_height(const lub_wall *w, double x, int upper, double *y)
     case LUB_WALL_CYLINDER:
     case LUB_WALL_SPHERE: {
         double lo, hi;
-        if (!round_roots(w, x, &lo, &hi)) return 0;
+        if (!round_roots(w, x, z, &lo, &hi)) return 0;
         /* the surface point facing the gap: fluid outside -> the upper wall's lowest point,
          * the lower wall's highest; fluid inside (a bearing shell) the other way round */
         *y = (upper != 0) == !w->fluid_inside ? lo : hi;
@@ -644,7 +651,7 @@ int lub_wall_height(const lub_wall *w, double x, int upper, double *y)
     }
     case LUB_WALL_BOX:
         if (x < w->min[0] || x > w->max[0]) return 0;
-        if (w->max[2] != w->min[2] && (0.0 < w->min[2] || 0.0 > w->max[2])) return 0;
+        if (w->max[2] != w->min[2] && (z < w->min[2] || z > w->max[2])) return 0;
         *y = (upper != 0) == !w->fluid_inside ? w->min[1] : w->max[1];
         return 1;
     case LUB_WALL_POLYGON: {

@@ -84,8 +84,8 @@ typedef struct {
     int has_range;         /* cylinder arc / plane limited in x */
     double range[2];
     int fluid_layers; /* cylinder, sphere: fluid on this many surfaces k l0 out (discretise.h) */
-    int has_length; /* 3-D cylinder of finite length (flat ends) */
-    double length;  /* along the axis, centred on the centre */
+    int has_length;   /* 3-D cylinder of finite length (flat ends) */
+    double length;    /* along the axis, centred on the centre */
 } lub_wall;
 
 typedef enum { LUB_REGION_LAYER, LUB_REGION_BOX, LUB_REGION_BETWEEN } lub_region_type;
@@ -138,6 +138,11 @@ int lub_geometry_find_wall(const lub_geometry *g, const char *name);
  * lower wall the highest (a polygon over a film: its lower surface, a vertical face at x
  * included).  Returns 1 and sets *y, or 0 when the wall does not span x. */
 int lub_wall_height(const lub_wall *w, double x, int upper, double *y);
+
+/* The same on the vertical line through (x, z) in 3-D (lub_wall_height is z = 0): a sphere's
+ * or a cylinder's surface, a plane with a z-component in its normal, a box's or a finite
+ * roller's extent in z.  The 2-D walls (segment, polyline, polygon) do not depend on z. */
+int lub_wall_height_at(const lub_wall *w, double x, double z, int upper, double *y);
 
 /* Signed distance from point x to the wall surface, positive on the fluid side. */
 double lub_wall_distance(const lub_wall *w, const double *x, int dim);

@@ -395,7 +395,89 @@ void lub_refgap_free(lub_refgap *G)
     free(G->h);
     free(G->hf);
     free(G->dhdt);
-    G->h = G->hf = G->dhdt = NULL;
+    free(G->ha);
+    free(G->hfx);
+    free(G->hfz);
+    free(G->dhdta);
+    G->h = G->hf = G->dhdt = G->ha = G->hfx = G->hfz = G->dhdta = NULL;
+}
+
+/* Height of wall w over (x, z) of the area, fatal at the width entry when it has none. */
+static double wall_y_at(const lub_refcase *rc, const lub_wall *w, double x, double z, int upper)
+{
+    const lub_refcase_settings *s = &rc->s;
+    double y;
+    char note[160];
+    if (!lub_wall_height_at(w, x, z, upper, &y))
+        lub_node_error(s->width_node,
+                       "the %s wall '%s'%s does not span the area [inlet, outlet] x [-width/2, "
+                       "width/2] = [%g, %g] x [%g, %g]: no surface over (x, z) = (%.9g, %.9g)",
+                       upper ? "upper" : "lower", w->name, moved_note(rc, w, note, sizeof note),
+                       s->inlet, s->outlet, -0.5 * s->width, 0.5 * s->width, x, z);
+    return y;
+}
+
+/* The gap over (x, z), fatal at the width entry when it is <= 0. */
+static double gap_at(const lub_refcase *rc, double x, double z)
+{
+    double gap = wall_y_at(rc, rc->upper, x, z, 1) - wall_y_at(rc, rc->lower, x, z, 0);
+    if (!(gap > 0.0))
+        lub_node_error(rc->s.width_node,
+                       "the gap between '%s' and '%s' is %s at (x, z) = (%.9g, %.9g) at t = %g "
+                       "s: it must be > 0 over the area",
+                       rc->s.lower, rc->s.upper, gap == 0.0 ? "zero" : "negative", x, z, rc->t);
+    return gap;
+}
+
+/* The slope of wall w's surface along x (dir 0) or z (dir 2) at (x, z), by central
+ * differences inside the area. */
+static double wall_slope_at(const lub_refcase *rc, const lub_wall *w, double x, double z, int dir,
+                            int upper, double step)
+{
+    const lub_refcase_settings *s = &rc->s;
+    double d = 1e-3 * step;
+    if (dir == 0) {
+        double xl = fmax(x - d, s->inlet), xr = fmin(x + d, s->outlet);
+        return (wall_y_at(rc, w, xr, z, upper) - wall_y_at(rc, w, xl, z, upper)) / (xr - xl);
+    }
+    double zl = fmax(z - d, -0.5 * s->width), zr = fmin(z + d, 0.5 * s->width);
+    return (wall_y_at(rc, w, x, zr, upper) - wall_y_at(rc, w, x, zl, upper)) / (zr - zl);
+}
+
+void lub_refgap_sample_area(lub_refgap *G, const lub_refcase *rc)
+{
+    const int n = G->n, nz = G->nz = (int)rc->s.nz;
+    const double w = G->width = rc->s.width, dz = w / nz;
+    size_t nn = (size_t)(n + 1) * (nz + 1);
+    G->ha = lub_malloc(nn * sizeof *G->ha);
+    G->dhdta = lub_malloc(nn * sizeof *G->dhdta);
+    G->hfx = lub_malloc((size_t)n * (nz + 1) * sizeof *G->hfx);
+    G->hfz = lub_malloc((size_t)(n + 1) * nz * sizeof *G->hfz);
+    G->h0_area = INFINITY;
+    G->varies_across = 0;
+    const double *vl = rc->vel[rc->wl], *vu = rc->vel[rc->wu];
+    /* z_j as reynolds2d.h's lub_reynolds2d_z, so that z = 0 is exactly the mid-plane */
+#define ZJ(j) (-0.5 * w + w * (double)(j) / (double)nz)
+    for (int i = 0; i <= n; i++) {
+        double x = i == n ? G->xb : G->xa + i * G->dx, xf = G->xa + (i + 0.5) * G->dx;
+        for (int j = 0; j <= nz; j++) {
+            double z = ZJ(j);
+            size_t q = (size_t)i * (nz + 1) + j;
+            double h = G->ha[q] = gap_at(rc, x, z);
+            if (i < n) G->hfx[q] = gap_at(rc, xf, z);
+            if (j < nz) G->hfz[(size_t)i * nz + j] = gap_at(rc, x, ZJ(j) + 0.5 * dz);
+            if (h < G->h0_area) G->h0_area = h, G->x_h0_area = x, G->z_h0_area = z;
+            double r = vu[1] - vl[1];
+            if (vu[0] != 0.0) r -= vu[0] * wall_slope_at(rc, rc->upper, x, z, 0, 1, G->dx);
+            if (vl[0] != 0.0) r += vl[0] * wall_slope_at(rc, rc->lower, x, z, 0, 0, G->dx);
+            if (vu[2] != 0.0) r -= vu[2] * wall_slope_at(rc, rc->upper, x, z, 2, 1, dz);
+            if (vl[2] != 0.0) r += vl[2] * wall_slope_at(rc, rc->lower, x, z, 2, 0, dz);
+            G->dhdta[q] = r;
+            G->moving_shape |= r != 0.0;
+            if (j > 0 && (h != G->ha[q - 1] || r != G->dhdta[q - 1])) G->varies_across = 1;
+        }
+    }
+#undef ZJ
 }
 
 lub_reynolds_status lub_refcase_solve(const lub_refcase *rc, const lub_refgap *G, double *p,

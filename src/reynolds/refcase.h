@@ -105,6 +105,14 @@ typedef struct {
     double *h, *hf, *dhdt;
     double h0, x_h0;
     int moving_shape; /* dh/dt != 0 somewhere */
+    /* The finite width (lub_refgap_sample_area): the gap over the area [xa, xb] x [-W/2, W/2]
+     * on the (n, nz) grid of reynolds2d.h, at the nodes (index i (nz + 1) + j), the x faces
+     * (i (nz + 1) + j) and the z faces (i nz + j), dh/dt at the nodes; NULL before. */
+    int nz;
+    double width;
+    double *ha, *hfx, *hfz, *dhdta;
+    double h0_area, x_h0_area, z_h0_area; /* the smallest sampled gap over the area, where */
+    int varies_across;                    /* h or dh/dt is not the same on every z */
 } lub_refgap;
 
 /* Sample h (and dh/dt from the wall velocities: normal speeds, and each surface carried
@@ -113,6 +121,16 @@ typedef struct {
  * t > 0 with the time at which the moving walls touch). */
 void lub_refgap_sample(lub_refgap *G, const lub_refcase *rc);
 void lub_refgap_free(lub_refgap *G);
+
+/* The gap over the area for the finite-width reference (width, nz of reynoldsRefDict.yaml),
+ * after lub_refgap_sample: h(x, z) = (upper wall height) - (lower wall height) on the vertical
+ * line through (x, z) (lub_wall_height_at: a sphere over a plane gives the point contact's
+ * h0 + (x^2 + z^2)/(2R) near its lowest point), dh/dt from the walls' velocities (normal
+ * speeds, and each surface carried along x and z).  Fatal (naming the width entry) when a
+ * wall does not span the area or the gap is <= 0 in it.  A gap uniform in z (walls of a 2-D
+ * section extruded, a roller along z) gives every z the values of the mid-plane's h(x) bit
+ * for bit. */
+void lub_refgap_sample_area(lub_refgap *G, const lub_refcase *rc);
 
 /* Solve the rigid reference on the gap G (the Reynolds equation with the case's U1, U2, mu,
  * boundary condition, tolerance and iterations: what reynoldsRef solves without soft EHL):

@@ -33,20 +33,46 @@ static double face_gap(const lub_reynolds2d_problem *pb, int i)
     return pb->h_face ? pb->h_face[i] : 0.5 * (pb->h[i] + pb->h[i + 1]);
 }
 
-/* The gap at x_i + s dx (0 <= s <= 1): the quadratic through node, face and node when the
- * face gaps are given, else linear (as reynolds.c). */
-static double gap_in_cell(const lub_reynolds2d_problem *pb, int i, double s)
+/* The gap at node (i, j), at the x face (x_i + dx/2, z_j) and at the z face (x_i, z_j + dz/2):
+ * from h_area when the gap varies across, else h(x) (reynolds2d.h). */
+static double gap_node(const lub_reynolds2d_problem *pb, int i, int j)
 {
-    double h0 = pb->h[i], h1 = pb->h[i + 1];
-    if (!pb->h_face) return h0 + s * (h1 - h0);
-    double hm = pb->h_face[i];
+    return pb->h_area ? pb->h_area[(size_t)i * (pb->nz + 1) + j] : pb->h[i];
+}
+static double gap_face_x(const lub_reynolds2d_problem *pb, int i, int j)
+{
+    if (!pb->h_area) return face_gap(pb, i);
+    if (pb->h_face_x) return pb->h_face_x[(size_t)i * (pb->nz + 1) + j];
+    return 0.5 * (gap_node(pb, i, j) + gap_node(pb, i + 1, j));
+}
+static double gap_face_z(const lub_reynolds2d_problem *pb, int i, int j)
+{
+    if (!pb->h_area) return pb->h[i];
+    if (pb->h_face_z) return pb->h_face_z[(size_t)i * pb->nz + j];
+    return 0.5 * (gap_node(pb, i, j) + gap_node(pb, i, j + 1));
+}
+static double squeeze_at(const lub_reynolds2d_problem *pb, int i, int j)
+{
+    if (pb->h_area) return pb->dhdt_area ? pb->dhdt_area[(size_t)i * (pb->nz + 1) + j] : pb->dhdt;
+    return pb->dhdt_nodes ? pb->dhdt_nodes[i] : pb->dhdt;
+}
+
+/* The gap at x_i + s dx (0 <= s <= 1) on row j: the quadratic through node, face and node
+ * when the face gaps are given, else linear (as reynolds.c). */
+static double gap_in_cell(const lub_reynolds2d_problem *pb, int i, int j, double s)
+{
+    double h0 = gap_node(pb, i, j), h1 = gap_node(pb, i + 1, j);
+    if (!(pb->h_area ? pb->h_face_x : pb->h_face)) return h0 + s * (h1 - h0);
+    double hm = gap_face_x(pb, i, j);
     return h0 * 2.0 * (s - 0.5) * (s - 1.0) - hm * 4.0 * s * (s - 1.0) + h1 * 2.0 * s * (s - 0.5);
 }
 
 /* Assemble M and f: the balance of the control volume vx dz around each node (vx = dx, or
- * (dx + cut)/2 at the cut exit) of the fluxes h^3/(12 mu) grad p through its four faces
- * against the wedge term Um (h_r - h_l) dz and the squeeze and source terms times the
- * volume.  Columns in increasing order: west, south, the node, north, east. */
+ * (dx + cut)/2 at the cut exit) of the fluxes h^3/(12 mu) grad p through its four faces,
+ * each with its face's gap, against the wedge term Um (h_r - h_l) dz and the squeeze and
+ * source terms times the volume.  Columns in increasing order: west, south, the node,
+ * north, east.  The diagonal sums the z coefficients first (as + an), which is 2 an exactly
+ * when the gap is uniform in z. */
 static void assemble(sys2d *S)
 {
     const lub_reynolds2d_problem *pb = S->pb;
@@ -63,28 +89,24 @@ static void assemble(sys2d *S)
     lub_csr_alloc(A);
     if (!S->a0) S->a0 = lub_malloc((size_t)A->nnz * sizeof *S->a0);
     for (int i = 1; i < m; i++) {
-        double dl = dx, dr = dx, hl = face_gap(pb, i - 1), hr;
-        if (i == m - 1 && S->cut > 0.0) {
-            dr = S->cut;
-            hr = gap_in_cell(pb, i, 0.5 * S->cut / dx);
-        } else {
-            hr = face_gap(pb, i);
-        }
-        double vx = 0.5 * (dl + dr), hi = pb->h[i];
-        double aw = hl * hl * hl * c12 * dz / dl, ae = hr * hr * hr * c12 * dz / dr;
-        double an = hi * hi * hi * c12 * vx / dz;
-        double dhdt = pb->dhdt_nodes ? pb->dhdt_nodes[i] : pb->dhdt;
+        int cut = i == m - 1 && S->cut > 0.0;
+        double dl = dx, dr = cut ? S->cut : dx, vx = 0.5 * (dl + dr);
         for (int j = 1; j <= nzi; j++) {
+            double hl = gap_face_x(pb, i - 1, j);
+            double hr = cut ? gap_in_cell(pb, i, j, 0.5 * S->cut / dx) : gap_face_x(pb, i, j);
+            double hs = gap_face_z(pb, i, j - 1), hn = gap_face_z(pb, i, j);
+            double aw = hl * hl * hl * c12 * dz / dl, ae = hr * hr * hr * c12 * dz / dr;
+            double as = hs * hs * hs * c12 * vx / dz, an = hn * hn * hn * c12 * vx / dz;
             int u = (i - 1) * nzi + j - 1, k = 0;
             int *c = lub_csr_row_col(A, u);
             double *v = lub_csr_row_val(A, u);
             if (i > 1) c[k] = u - nzi, v[k++] = -aw;
-            if (j > 1) c[k] = u - 1, v[k++] = -an;
-            c[k] = u, v[k++] = aw + ae + 2.0 * an;
+            if (j > 1) c[k] = u - 1, v[k++] = -as;
+            c[k] = u, v[k++] = aw + ae + (as + an);
             if (j < nzi) c[k] = u + 1, v[k++] = -an;
             if (i < m - 1) c[k] = u + nzi, v[k++] = -ae;
             double s = pb->source ? pb->source[i * (pb->nz + 1) + j] : 0.0;
-            S->f[u] = um * (hr - hl) * dz + (dhdt + s) * vx * dz;
+            S->f[u] = um * (hr - hl) * dz + (squeeze_at(pb, i, j) + s) * vx * dz;
         }
     }
     lub_csr_finish(A);
@@ -178,24 +200,31 @@ static lub_reynolds_status coarse_start(const lub_reynolds2d_problem *pb, sys2d 
 {
     const int nx = pb->nx, nz = pb->nz;
     int nxc = (nx + 1) / 2, nzc = 2 * ((nz / 2 + 1) / 2), even = nx % 2 == 0;
-    double *hc = lub_malloc((size_t)(nxc + 1) * sizeof *hc);
-    double *hfc = even ? lub_malloc((size_t)nxc * sizeof *hfc) : NULL;
-    double *rc = pb->dhdt_nodes ? lub_malloc((size_t)(nxc + 1) * sizeof *rc) : NULL;
+    const int area = pb->h_area != NULL;
+    double *hc = area ? NULL : lub_malloc((size_t)(nxc + 1) * sizeof *hc);
+    double *hfc = even && !area ? lub_malloc((size_t)nxc * sizeof *hfc) : NULL;
+    double *rc = pb->dhdt_nodes && !area ? lub_malloc((size_t)(nxc + 1) * sizeof *rc) : NULL;
     size_t nc = (size_t)(nxc + 1) * (nzc + 1);
     double *sc = pb->source ? lub_malloc(nc * sizeof *sc) : NULL;
     double *pc = lub_malloc(nc * sizeof *pc);
+    /* a gap varying across: its nodes (and dh/dt) interpolated, the faces the nodes' means */
+    double *hac = area ? lub_malloc(nc * sizeof *hac) : NULL;
+    double *rac = area && pb->dhdt_area ? lub_malloc(nc * sizeof *rac) : NULL;
     for (int i = 0; i <= nxc; i++) {
         double sf = (double)i * nx / nxc;
         int k = (int)sf;
         if (k >= nx) k = nx - 1;
         double w = sf - k;
-        hc[i] = (1.0 - w) * pb->h[k] + w * pb->h[k + 1];
+        if (hc) hc[i] = (1.0 - w) * pb->h[k] + w * pb->h[k + 1];
         if (rc) rc[i] = (1.0 - w) * pb->dhdt_nodes[k] + w * pb->dhdt_nodes[k + 1];
         if (hfc && i < nxc) hfc[i] = pb->h[2 * i + 1];
-        if (sc)
-            for (int j = 0; j <= nzc; j++)
-                sc[(size_t)i * (nzc + 1) + j] =
-                    bilinear(pb->source, nx, nz, sf, (double)j * nz / nzc);
+        for (int j = 0; j <= nzc; j++) {
+            size_t q = (size_t)i * (nzc + 1) + j;
+            double sj = (double)j * nz / nzc;
+            if (sc) sc[q] = bilinear(pb->source, nx, nz, sf, sj);
+            if (hac) hac[q] = bilinear(pb->h_area, nx, nz, sf, sj);
+            if (rac) rac[q] = bilinear(pb->dhdt_area, nx, nz, sf, sj);
+        }
     }
     lub_reynolds2d_problem cp = *pb;
     cp.nx = nxc;
@@ -204,6 +233,9 @@ static lub_reynolds_status coarse_start(const lub_reynolds2d_problem *pb, sys2d 
     cp.h_face = hfc;
     cp.dhdt_nodes = rc;
     cp.source = sc;
+    cp.h_area = hac;
+    cp.h_face_x = cp.h_face_z = NULL;
+    cp.dhdt_area = rac;
     int itc = 0, ncav = 0;
     lub_reynolds_status st = solve_grid(&cp, pc, &itc, &ncav, lin_its);
     if (st == LUB_REYNOLDS_OK) {
@@ -218,6 +250,8 @@ static lub_reynolds_status coarse_start(const lub_reynolds2d_problem *pb, sys2d 
     free(rc);
     free(sc);
     free(pc);
+    free(hac);
+    free(rac);
     return st;
 }
 
@@ -294,7 +328,7 @@ static lub_reynolds_status solve_grid(const lub_reynolds2d_problem *pb, double *
 
 static lub_reynolds_status check_input(const lub_reynolds2d_problem *pb)
 {
-    if (!pb->h || pb->nx < 2 || pb->nz < 2 || pb->nz % 2 || !isfinite(pb->xa) ||
+    if ((!pb->h && !pb->h_area) || pb->nx < 2 || pb->nz < 2 || pb->nz % 2 || !isfinite(pb->xa) ||
         !isfinite(pb->xb) || !(pb->xb > pb->xa) || !(pb->width > 0.0) || !isfinite(pb->width) ||
         !(pb->mu > 0.0) || !isfinite(pb->mu) || !isfinite(pb->u1) || !isfinite(pb->u2) ||
         !isfinite(pb->dhdt) || pb->tolerance < 0.0 || pb->max_iterations < 0 || (int)pb->bc < 0 ||
@@ -302,6 +336,19 @@ static lub_reynolds_status check_input(const lub_reynolds2d_problem *pb)
         return LUB_REYNOLDS_BAD_INPUT;
     if (pb->bc == LUB_REYNOLDS_BC_GIVEN_EXIT && !(pb->exit_x > pb->xa && pb->exit_x <= pb->xb))
         return LUB_REYNOLDS_BAD_INPUT;
+    if (pb->h_area) {
+        const int nx = pb->nx, nz = pb->nz;
+        for (size_t q = 0; q < (size_t)(nx + 1) * (nz + 1); q++) {
+            if (!(pb->h_area[q] > 0.0) || !isfinite(pb->h_area[q])) return LUB_REYNOLDS_BAD_GAP;
+            if (pb->dhdt_area && !isfinite(pb->dhdt_area[q])) return LUB_REYNOLDS_BAD_INPUT;
+        }
+        for (size_t q = 0; pb->h_face_x && q < (size_t)nx * (nz + 1); q++)
+            if (!(pb->h_face_x[q] > 0.0) || !isfinite(pb->h_face_x[q])) return LUB_REYNOLDS_BAD_GAP;
+        for (size_t q = 0; pb->h_face_z && q < (size_t)(nx + 1) * nz; q++)
+            if (!(pb->h_face_z[q] > 0.0) || !isfinite(pb->h_face_z[q])) return LUB_REYNOLDS_BAD_GAP;
+        return LUB_REYNOLDS_OK;
+    }
+    if (!pb->h) return LUB_REYNOLDS_BAD_INPUT;
     for (int i = 0; i <= pb->nx; i++) {
         if (!(pb->h[i] > 0.0) || !isfinite(pb->h[i])) return LUB_REYNOLDS_BAD_GAP;
         if (pb->dhdt_nodes && !isfinite(pb->dhdt_nodes[i])) return LUB_REYNOLDS_BAD_INPUT;
@@ -328,7 +375,8 @@ static void figures(const lub_reynolds2d_problem *pb, lub_reynolds2d_result *res
     double load = 0.0, leak = 0.0, qin = 0.0, qout = 0.0;
     int im = 0, jmx = 0;
     for (int i = 0; i <= nx; i++) {
-        double k = pb->h[i] * pb->h[i] * pb->h[i] * c12;
+        double h0 = gap_node(pb, i, 0), h1 = gap_node(pb, i, nz);
+        double k0 = h0 * h0 * h0 * c12, k1 = h1 * h1 * h1 * c12;
         for (int j = 0; j <= nz; j++) {
             load += trap(i, nx) * trap(j, nz) * P(i, j);
             if (P(i, j) > P(im, jmx)) im = i, jmx = j;
@@ -336,15 +384,15 @@ static void figures(const lub_reynolds2d_problem *pb, lub_reynolds2d_result *res
         /* -k dp/dz out of z = +W/2, +k dp/dz out of z = -W/2 (one-sided, second order) */
         double gt = (3.0 * P(i, nz) - 4.0 * P(i, nz - 1) + P(i, nz - 2)) / (2.0 * dz);
         double gb = (-3.0 * P(i, 0) + 4.0 * P(i, 1) - P(i, 2)) / (2.0 * dz);
-        leak += trap(i, nx) * k * (gb - gt);
+        leak += trap(i, nx) * (k0 * gb - k1 * gt);
     }
-    double ka = pb->h[0] * pb->h[0] * pb->h[0] * c12;
-    double kb = pb->h[nx] * pb->h[nx] * pb->h[nx] * c12;
     for (int j = 0; j <= nz; j++) {
+        double ha = gap_node(pb, 0, j), hb = gap_node(pb, nx, j);
+        double ka = ha * ha * ha * c12, kb = hb * hb * hb * c12;
         double ga = (-3.0 * P(0, j) + 4.0 * P(1, j) - P(2, j)) / (2.0 * dx);
         double gb = (3.0 * P(nx, j) - 4.0 * P(nx - 1, j) + P(nx - 2, j)) / (2.0 * dx);
-        qin += trap(j, nz) * (um * pb->h[0] - ka * ga);
-        qout += trap(j, nz) * (um * pb->h[nx] - kb * gb);
+        qin += trap(j, nz) * (um * ha - ka * ga);
+        qout += trap(j, nz) * (um * hb - kb * gb);
     }
     res->load = load * dx * dz;
     res->leakage = leak * dx;

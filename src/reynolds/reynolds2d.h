@@ -3,7 +3,8 @@
  *
  * The 2-D Reynolds equation for an incompressible film, x along the motion, z across the
  * width W (z in [-W/2, W/2]), the gap h(x) uniform in z (the walls of a 2-D geometry
- * extruded over the width):
+ * extruded over the width) or h(x, z) varying across (h_area: a ball over a plane, the
+ * point contact h = h0 + (x^2 + z^2)/(2R)):
  *
  *     d/dx(h^3/(12 mu) dp/dx) + d/dz(h^3/(12 mu) dp/dz) = (U1 + U2)/2 dh/dx + dh/dt   (5.6)
  *
@@ -14,7 +15,9 @@
  *
  * Discretisation: the 1-D scheme of reynolds.c in x (fluxes at the face midpoints with the
  * face gap, a Shortley-Weller cut cell at a given exit between nodes) times central
- * differences in z on a uniform (nx, nz) grid of nodes x_i = xa + i dx, z_j = -W/2 + j dz.
+ * differences in z on a uniform (nx, nz) grid of nodes x_i = xa + i dx, z_j = -W/2 + j dz,
+ * the z fluxes likewise with the gap of their face (h(x_i, z_j +- dz/2): the node's gap when
+ * h is uniform in z, so that both forms give the same matrix bit for bit).
  * Each row is the balance of a control volume dx dz, so the matrix M (minus the operator) is
  * symmetric, an M-matrix, five entries a row: second order and conservative.  It is solved
  * by the linear solver chosen (src/linalg: CHOLMOD by default, or PCG with AMG).
@@ -33,11 +36,20 @@
 #include "reynolds/reynolds.h"
 
 typedef struct {
-    int nx, nz;               /* cells in x and z (nz even: the mid-plane is a grid line) */
-    double xa, xb;            /* inlet and outlet, xa < xb */
-    double width;             /* W > 0: z in [-W/2, W/2] */
-    const double *h;          /* gap at the nx + 1 x nodes [m] */
-    const double *h_face;     /* gap at the nx face midpoints, or NULL: mean of the nodes */
+    int nx, nz;           /* cells in x and z (nz even: the mid-plane is a grid line) */
+    double xa, xb;        /* inlet and outlet, xa < xb */
+    double width;         /* W > 0: z in [-W/2, W/2] */
+    const double *h;      /* gap at the nx + 1 x nodes [m] (uniform in z) */
+    const double *h_face; /* gap at the nx face midpoints, or NULL: mean of the nodes */
+    /* A gap varying across, h(x, z) (a ball over a plane): when h_area is given it replaces
+     * h and h_face (which may then be NULL), and dhdt_area replaces dhdt and dhdt_nodes.
+     * Nodes (i, j) at index i (nz + 1) + j; the x faces (x_i + dx/2, z_j) at i (nz + 1) + j
+     * (nx (nz + 1) values), the z faces (x_i, z_j + dz/2) at i nz + j ((nx + 1) nz values);
+     * a NULL face array: the mean of the two nodes. */
+    const double *h_area;     /* gap at the (nx + 1)(nz + 1) nodes [m], or NULL */
+    const double *h_face_x;   /* gap at the x faces, or NULL */
+    const double *h_face_z;   /* gap at the z faces, or NULL */
+    const double *dhdt_area;  /* dh/dt at the nodes (with h_area), or NULL: dhdt */
     double u1, u2;            /* x speeds of the lower and upper surface [m/s] */
     double dhdt;              /* squeeze rate when dhdt_nodes is NULL [m/s] */
     const double *dhdt_nodes; /* dh/dt at the nx + 1 x nodes, or NULL */

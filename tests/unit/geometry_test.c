@@ -105,6 +105,9 @@ static void test_wall_functions(void)
     CHECK(lub_wall_height(c, 0.6, 1, &y) && fabs(y - 1.2) < 1e-14);
     CHECK(lub_wall_height(c, 0.6, 0, &y) && fabs(y - 2.8) < 1e-14);
     CHECK(!lub_wall_height(c, 1.5, 1, &y));
+    /* a 2-D circle is a cylinder extruded in z: the same height on every z (reynoldsRef
+     * over a width) */
+    CHECK(lub_wall_height_at(c, 0.6, 5.0, 1, &y) && fabs(y - 1.2) < 1e-14);
     CHECK_NEAR(lub_wall_distance(c, (double[]){0, 0}, 2), 1.0, 1e-14);
     CHECK_NEAR(lub_wall_distance(c, (double[]){0, 2.5}, 2), -0.5, 1e-14);
     /* polyline tent */
@@ -135,6 +138,27 @@ static void test_wall_functions_3d(void)
     CHECK(lub_wall_height(&g.walls[1], 2.0, 1, &y) && fabs(y + 0.5) < 1e-14);
     CHECK_NEAR(lub_wall_distance(&g.walls[1], (double[]){7, 0, 1.5}, 3), 1.0, 1e-14);
     CHECK(lub_wall_height(&g.walls[2], 1.0, 0, &y) && fabs(y + 1.0) < 1e-14);
+    /* off the z = 0 section (lub_wall_height_at): the sphere's lowest point over (x, z) is
+     * 2 - sqrt(1 - x^2 - (z - 0.6)^2); the line misses it beyond its radius */
+    CHECK(lub_wall_height_at(&g.walls[0], 0.6, 0.6, 1, &y) && fabs(y - 1.2) < 1e-14);
+    CHECK(lub_wall_height_at(&g.walls[0], 0.0, 1.2, 1, &y) && fabs(y - 1.2) < 1e-14);
+    CHECK(lub_wall_height_at(&g.walls[0], 0.48, 0.0, 1, &y) && fabs(y - 1.36) < 1e-14);
+    CHECK(!lub_wall_height_at(&g.walls[0], 0.0, 1.7, 1, &y));
+    /* z = 0 is lub_wall_height */
+    double y0;
+    CHECK(lub_wall_height(&g.walls[0], 0.3, 1, &y0) &&
+          lub_wall_height_at(&g.walls[0], 0.3, 0.0, 1, &y) && y == y0);
+    /* the cylinder along x: its lower surface over (x, z) is -sqrt(0.25 - z^2) */
+    CHECK(lub_wall_height_at(&g.walls[1], 2.0, 0.3, 1, &y) && fabs(y + 0.4) < 1e-14);
+    lub_geometry_free(&g);
+    /* a tilted plane y = -0.5 z (normal (0, 2, 1)) and a roller of finite length along z */
+    read_text(&g, "dimension: 3\nl0: 0.1\ndomain: { min: [-3, -3, -3], max: [3, 3, 3] }\n"
+                  "walls:\n"
+                  "  tilt:   { type: plane, point: [0, 0, 0], normal: [0, 2, 1] }\n"
+                  "  roller: { type: cylinder, lowestPoint: [0, 1, 0], radius: 1, length: 1.0 }\n");
+    CHECK(lub_wall_height_at(&g.walls[0], 0.7, 0.8, 0, &y) && fabs(y + 0.4) < 1e-14);
+    CHECK(lub_wall_height_at(&g.walls[1], 0.6, 0.5, 1, &y) && fabs(y - 1.2) < 1e-14);
+    CHECK(!lub_wall_height_at(&g.walls[1], 0.6, 0.6, 1, &y)); /* beyond its end */
     lub_geometry_free(&g);
 }
 

@@ -7,6 +7,9 @@
  *     Reynolds condition) like 1/cosh(pi W/(2 L_p)), L_p the pressurised length;
  *   - the short-bearing limit: an inclined slider of width W << L against Ocvirk's closed
  *     form p = 6 mu Um h'/h^3 (z^2 - W^2/4) (doc/methods.md (5.7)), error ~ (W/L)^2;
+ *   - a gap varying across (h_area, the point contact of a ball over a plane): a manufactured
+ *     p on h = h0 + ((x - xc)^2 + z^2)/(2R) with a squeeze rate varying over the area, second
+ *     order; the gap uniform in z given as h_area gives the h(x) solution bit for bit;
  *   - the linear solvers: PCG with AMG gives CHOLMOD's answer to its tolerance;
  *   - bad input. */
 #include <math.h>
@@ -352,6 +355,184 @@ static void test_short_bearing(void)
     CHECK(e1 / e2 > 3.5 && e1 / e2 < 4.5);
 }
 
+/* --- a gap varying across (h_area) ------------------------------------------------------- */
+
+/* The point contact: a ball of radius R over a plane, h = h0 + ((x - xc)^2 + z^2)/(2R) (the
+ * paraboloid of the ball's lowest point), on [0, L] x [-W/2, W/2]; dh/dt varying over the
+ * area.  The manufactured p is ms_p; its source (k = h^3/(12 mu), k_x = h^2 h_x/(4 mu)):
+ *   s = k_x p_x + k_z p_z + k (p_xx + p_zz) - Um h_x - dh/dt. */
+static const double PC_R = 0.02, PC_XC = 0.4 * 2e-3;
+
+static double pc_h(double x, double z)
+{
+    return MS_H0 + ((x - PC_XC) * (x - PC_XC) + z * z) / (2.0 * PC_R);
+}
+static double pc_dhdt(double x, double z, double w)
+{
+    return MS_DHDT * (1.0 + 0.5 * z / w + 0.3 * x / MS_L);
+}
+static double pc_source(double x, double z, double w)
+{
+    double h = pc_h(x, z), hx = (x - PC_XC) / PC_R, hz = z / PC_R;
+    double k = h * h * h / (12.0 * MS_MU), c = h * h / (4.0 * MS_MU);
+    double a = M_PI / MS_L, b = M_PI / w;
+    double px = MS_P * a * cos(a * x) * cos(b * z), pz = -MS_P * b * sin(a * x) * sin(b * z);
+    double lap = -(a * a + b * b) * ms_p(x, z, w);
+    return c * hx * px + c * hz * pz + k * lap - 0.5 * (MS_U1 + MS_U2) * hx - pc_dhdt(x, z, w);
+}
+
+typedef struct {
+    double *h, *fx, *fz, *r, *src, *p;
+} pc_arrays;
+
+/* The manufactured point contact on an (nx, nz) grid; faces sampled (faces != 0) or NULL
+ * (the nodes' means). */
+static void pc_problem(lub_reynolds2d_problem *pb, pc_arrays *a, int nx, int nz, double w,
+                       int faces, lub_reynolds_bc bc)
+{
+    lub_reynolds2d_problem_init(pb);
+    pb->nx = nx;
+    pb->nz = nz;
+    pb->xb = MS_L;
+    pb->width = w;
+    pb->u1 = MS_U1;
+    pb->u2 = MS_U2;
+    pb->mu = MS_MU;
+    pb->bc = bc;
+    size_t nn = (size_t)(nx + 1) * (nz + 1);
+    double dx = MS_L / nx, dz = w / nz;
+    a->h = malloc(nn * sizeof *a->h);
+    a->r = malloc(nn * sizeof *a->r);
+    a->src = malloc(nn * sizeof *a->src);
+    a->p = malloc(nn * sizeof *a->p);
+    a->fx = malloc((size_t)nx * (nz + 1) * sizeof *a->fx);
+    a->fz = malloc((size_t)(nx + 1) * nz * sizeof *a->fz);
+    for (int i = 0; i <= nx; i++)
+        for (int j = 0; j <= nz; j++) {
+            double x = i * dx, z = lub_reynolds2d_z(pb, j);
+            a->h[i * (nz + 1) + j] = pc_h(x, z);
+            a->r[i * (nz + 1) + j] = pc_dhdt(x, z, w);
+            a->src[i * (nz + 1) + j] = pc_source(x, z, w);
+            if (i < nx) a->fx[i * (nz + 1) + j] = pc_h(x + 0.5 * dx, z);
+            if (j < nz) a->fz[i * nz + j] = pc_h(x, z + 0.5 * dz);
+        }
+    pb->h_area = a->h;
+    pb->h_face_x = faces ? a->fx : NULL;
+    pb->h_face_z = faces ? a->fz : NULL;
+    pb->dhdt_area = a->r;
+    pb->source = a->src;
+}
+
+static void pc_free(pc_arrays *a)
+{
+    free(a->h);
+    free(a->fx);
+    free(a->fz);
+    free(a->r);
+    free(a->src);
+    free(a->p);
+}
+
+/* The grid error falls as dx^2 + dz^2 with the faces' gaps sampled and with the nodes'
+ * means; the complementarity path gives the same (p > 0 inside: nothing cavitates). */
+static void test_area_manufactured(void)
+{
+    double w = 0.6 * MS_L;
+    for (int faces = 1; faces >= 0; faces--) {
+        double e[3];
+        int n[3] = {16, 32, 64};
+        for (int k = 0; k < 3; k++) {
+            lub_reynolds2d_problem pb;
+            pc_arrays a;
+            pc_problem(&pb, &a, n[k], n[k], w, faces, LUB_REYNOLDS_BC_FULL_SOMMERFELD);
+            lub_reynolds2d_result r = {.p = a.p};
+            CHECK(lub_reynolds2d_solve(&pb, &r) == LUB_REYNOLDS_OK);
+            double m = 0.0, dx = MS_L / n[k];
+            for (int i = 0; i <= n[k]; i++)
+                for (int j = 0; j <= n[k]; j++)
+                    m = fmax(m, fabs(a.p[i * (n[k] + 1) + j] -
+                                     ms_p(i * dx, lub_reynolds2d_z(&pb, j), w)));
+            e[k] = m / MS_P;
+            if (k == 2) { /* the Reynolds condition: no node cavitates, the same answer */
+                lub_reynolds2d_problem pr;
+                pc_arrays b;
+                pc_problem(&pr, &b, n[k], n[k], w, faces, LUB_REYNOLDS_BC_REYNOLDS);
+                lub_reynolds2d_result rr = {.p = b.p};
+                CHECK(lub_reynolds2d_solve(&pr, &rr) == LUB_REYNOLDS_OK);
+                CHECK(rr.n_cavitated == 0);
+                double d = 0.0;
+                for (int q = 0; q < (n[k] + 1) * (n[k] + 1); q++)
+                    d = fmax(d, fabs(a.p[q] - b.p[q]));
+                CHECK(d <= 1e-9 * MS_P);
+                pc_free(&b);
+            }
+            pc_free(&a);
+        }
+        printf("  point contact, faces %s: max error / P = %.3e %.3e %.3e (16, 32, 64 cells), "
+               "orders %.3f %.3f\n",
+               faces ? "sampled" : "means", e[0], e[1], e[2], log2(e[0] / e[1]), log2(e[1] / e[2]));
+        CHECK(e[2] < 1e-3);
+        CHECK_NEAR(log2(e[0] / e[1]), 2.0, 0.15);
+        CHECK_NEAR(log2(e[1] / e[2]), 2.0, 0.15);
+    }
+}
+
+/* The roller's gap h(x) given as h_area (every z the same; x faces the same, z faces the
+ * nodes' means = the node) gives the h(x) path's pressure bit for bit: the Reynolds
+ * condition (a cavitated exit, the coarse-grid start) and a given exit between nodes (the
+ * cut cell); the figures to round-off. */
+static void test_area_uniform(void)
+{
+    const double s = sqrt(WL_R * WL_H0), xa = -4.0 * s, xb = 2.0 * s;
+    const int nx = 120, nz = 32;
+    double h[nx + 1], hf[nx];
+    wl_gap(nx, xa, xb, h, hf);
+    double *ha = malloc((size_t)(nx + 1) * (nz + 1) * sizeof *ha);
+    double *fx = malloc((size_t)nx * (nz + 1) * sizeof *fx);
+    for (int i = 0; i <= nx; i++)
+        for (int j = 0; j <= nz; j++) {
+            ha[i * (nz + 1) + j] = h[i];
+            if (i < nx) fx[i * (nz + 1) + j] = hf[i];
+        }
+    lub_reynolds_bc bcs[2] = {LUB_REYNOLDS_BC_REYNOLDS, LUB_REYNOLDS_BC_GIVEN_EXIT};
+    for (int k = 0; k < 2; k++) {
+        lub_reynolds2d_problem p1, p2;
+        lub_reynolds2d_problem_init(&p1);
+        p1.nx = nx;
+        p1.nz = nz;
+        p1.xa = xa;
+        p1.xb = xb;
+        p1.width = 1.5 * (xb - xa);
+        p1.h = h;
+        p1.h_face = hf;
+        p1.u1 = 1.0;
+        p1.mu = WL_MU;
+        p1.bc = bcs[k];
+        p1.exit_x = xa + 0.8137 * (xb - xa);
+        p2 = p1;
+        p2.h = p2.h_face = NULL;
+        p2.h_area = ha;
+        p2.h_face_x = fx;
+        double *q1 = malloc((size_t)(nx + 1) * (nz + 1) * sizeof *q1);
+        double *q2 = malloc((size_t)(nx + 1) * (nz + 1) * sizeof *q2);
+        lub_reynolds2d_result r1 = {.p = q1}, r2 = {.p = q2};
+        CHECK(lub_reynolds2d_solve(&p1, &r1) == LUB_REYNOLDS_OK);
+        CHECK(lub_reynolds2d_solve(&p2, &r2) == LUB_REYNOLDS_OK);
+        int same = 1;
+        for (int q = 0; q < (nx + 1) * (nz + 1); q++) same &= q1[q] == q2[q];
+        CHECK(same);
+        CHECK(r1.n_cavitated == r2.n_cavitated);
+        if (k == 0) CHECK(r1.n_cavitated > 0);
+        CHECK(r1.load == r2.load);
+        CHECK_REL(r2.leakage, r1.leakage, 1e-12);
+        CHECK_REL(r2.q_in, r1.q_in, 1e-12);
+        free(q1);
+        free(q2);
+    }
+    free(ha);
+    free(fx);
+}
+
 /* --- solvers and input ------------------------------------------------------------------ */
 
 /* PCG with AMG gives CHOLMOD's answer to its tolerance, on the complementarity path too. */
@@ -393,6 +574,16 @@ static void test_bad_input(void)
     a.h[3] = -1e-6;
     CHECK(lub_reynolds2d_solve(&pb, &r) == LUB_REYNOLDS_BAD_GAP);
     ms_free(&a);
+    lub_reynolds2d_problem pa;
+    pc_arrays c;
+    pc_problem(&pa, &c, 16, 8, w, 1, LUB_REYNOLDS_BC_FULL_SOMMERFELD);
+    r.p = c.p;
+    c.fz[5] = 0.0;
+    CHECK(lub_reynolds2d_solve(&pa, &r) == LUB_REYNOLDS_BAD_GAP);
+    c.fz[5] = c.h[5];
+    c.h[9 * 9 + 4] = NAN;
+    CHECK(lub_reynolds2d_solve(&pa, &r) == LUB_REYNOLDS_BAD_GAP);
+    pc_free(&c);
 }
 
 int main(void)
@@ -403,6 +594,8 @@ int main(void)
     RUN(test_wide_limit);
     RUN(test_wide_limit_conditions);
     RUN(test_short_bearing);
+    RUN(test_area_manufactured);
+    RUN(test_area_uniform);
     RUN(test_pcg_matches_cholmod);
     RUN(test_bad_input);
     return test_summary();

@@ -151,10 +151,13 @@ static void table2d_write(const lub_case *c, const char *tname, const lub_reynol
 
 /* The finite-width reference (width in reynoldsRefDict.yaml, reynolds2d.h) at the walls'
  * time: solve over the area, write p2d.dat and the mid-plane's p.dat, report. */
-static void reference2d(const lub_case *c, const lub_refcase *rc, const lub_refgap *G,
+static void reference2d(const lub_case *c, const lub_refcase *rc, lub_refgap *G,
                         const char *out_file, const char *tname, int dimensionless, double t_start)
 {
     const lub_refcase_settings *s = &rc->s;
+    /* the gap over the area: h(x, z) of the walls on every line (x, z) (a ball over a plane),
+     * the same numbers on every z for walls uniform across (the roller) */
+    lub_refgap_sample_area(G, rc);
     lub_reynolds2d_problem pb;
     lub_reynolds2d_problem_init(&pb);
     pb.nx = G->n;
@@ -162,9 +165,10 @@ static void reference2d(const lub_case *c, const lub_refcase *rc, const lub_refg
     pb.xa = G->xa;
     pb.xb = G->xb;
     pb.width = s->width;
-    pb.h = G->h;
-    pb.h_face = G->hf;
-    pb.dhdt_nodes = G->dhdt;
+    pb.h_area = G->ha;
+    pb.h_face_x = G->hfx;
+    pb.h_face_z = G->hfz;
+    pb.dhdt_area = G->dhdta;
     pb.u1 = rc->u1;
     pb.u2 = rc->u2;
     pb.mu = rc->mu;
@@ -204,8 +208,13 @@ static void reference2d(const lub_case *c, const lub_refcase *rc, const lub_refg
                 s->upper, rc->u2, G->moving_shape ? ", dh/dt != 0 (wall motion)" : "");
     lub_message("oil         rho = %g kg/m^3, nu = %g m^2/s, mu = %g Pa s", rc->rho, rc->nu,
                 rc->mu);
-    lub_message("gap         h0 = %.6g m (minimum, at x = %.6g m), uniform across the width", G->h0,
-                G->x_h0);
+    if (G->varies_across)
+        lub_message("gap         h0 = %.6g m (minimum at the mid-plane, x = %.6g m), varying "
+                    "across the width (smallest node %.6g m at x = %.6g m, z = %.6g m)",
+                    G->h0, G->x_h0, G->h0_area, G->x_h0_area, G->z_h0_area);
+    else
+        lub_message("gap         h0 = %.6g m (minimum, at x = %.6g m), uniform across the width",
+                    G->h0, G->x_h0);
     lub_message("condition   %s, p = 0 at the sides z = +-%g m%s", lub_reynolds_bc_names[s->bc],
                 0.5 * pb.width,
                 s->bc == LUB_REYNOLDS_BC_REYNOLDS ? " (p >= 0; p = dp/dx = 0 at the free exit)"
@@ -418,7 +427,9 @@ int main(int argc, char **argv)
             "Finite width ('width' in reynoldsRefDict.yaml, with 'nz' cells across): the\n"
             "2-D Reynolds equation over the bearing's area, z across the motion,\n"
             "  d/dx(h^3/(12 mu) dp/dx) + d/dz(h^3/(12 mu) dp/dz) = (U1+U2)/2 dh/dx + dh/dt\n"
-            "with the gap uniform in z, p = 0 at the sides z = +-width/2 and the same x\n"
+            "with the gap h(x, z) of the walls over the area (uniform in z for a roller\n"
+            "along z; a sphere over a plane gives the point contact, h about\n"
+            "h0 + (x^2 + z^2)/(2R)), p = 0 at the sides z = +-width/2 and the same x\n"
             "conditions; solved by CHOLMOD (or 'linearSolver: pcg', with AMG).  Writes\n"
             "p2d.dat (x z p, a blank line between x columns: gnuplot splot) beside p.dat,\n"
             "which then holds the mid-plane z = 0, and reports the load [N] and the side\n"
