@@ -657,6 +657,21 @@ void lub_par_refresh(lub_par *d, void *a, size_t elsize)
     d->seconds += lub_wtime() - t0;
 }
 
+/* What a set of particles carries besides its particles (dimension, time, step, levels,
+ * patches, extra fields), from P into D, which receives P's records (gather, rows). */
+static void copy_header(lub_particles *D, const lub_particles *P, const char *what)
+{
+    D->dim = P->dim;
+    D->time = P->time;
+    D->step = P->step;
+    D->nlevels = P->nlevels;
+    memcpy(D->levels, P->levels, sizeof D->levels);
+    D->npatches = P->npatches;
+    memcpy(D->patch_names, P->patch_names, sizeof D->patch_names);
+    for (int e = 0; e < P->nextra; e++) lub_particles_extra(D, P->extra[e].name);
+    if (D->nextra != P->nextra) lub_bug("%s: %d extra fields into %d", what, P->nextra, D->nextra);
+}
+
 void lub_par_gather(lub_par *d, const lub_particles *P, lub_particles *G)
 {
     const double t0 = lub_wtime();
@@ -676,16 +691,7 @@ void lub_par_gather(lub_par *d, const lub_particles *P, lub_particles *G)
     MPI_Type_free(&t);
     if (d->rank == 0) {
         if (G->cap < (size_t)total) lub_particles_reserve(G, (size_t)total);
-        G->dim = P->dim;
-        G->time = P->time;
-        G->step = P->step;
-        G->nlevels = P->nlevels;
-        memcpy(G->levels, P->levels, sizeof G->levels);
-        G->npatches = P->npatches;
-        memcpy(G->patch_names, P->patch_names, sizeof G->patch_names);
-        for (int e = 0; e < P->nextra; e++) lub_particles_extra(G, P->extra[e].name);
-        if (G->nextra != P->nextra)
-            lub_bug("gather: %d extra fields into %d", P->nextra, G->nextra);
+        copy_header(G, P, "gather");
         for (long q = 0; q < total; q++) unpack(G, (size_t)q, rb + (size_t)q * nr);
         G->n = (size_t)total;
     }
@@ -753,15 +759,7 @@ size_t lub_par_rows(lub_par *d, const lub_particles *P, lub_particles *R, uint64
     MPI_Datatype t = record_type(nr * sizeof(double));
     MPI_Alltoallv(sb, d->mcount, d->mdispl, t, rb, d->mrcount, d->mrdispl, t, MPI_COMM_WORLD);
     MPI_Type_free(&t);
-    R->dim = P->dim;
-    R->time = P->time;
-    R->step = P->step;
-    R->nlevels = P->nlevels;
-    memcpy(R->levels, P->levels, sizeof R->levels);
-    R->npatches = P->npatches;
-    memcpy(R->patch_names, P->patch_names, sizeof R->patch_names);
-    for (int e = 0; e < P->nextra; e++) lub_particles_extra(R, P->extra[e].name);
-    if (R->nextra != P->nextra) lub_bug("rows: %d extra fields into %d", P->nextra, R->nextra);
+    copy_header(R, P, "rows");
     R->n = count;
     for (size_t r = 0; r < count; r++) R->id[r] = UINT64_MAX;
     for (long q = 0; q < nin; q++) {

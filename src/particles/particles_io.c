@@ -496,6 +496,19 @@ static int sync_parent(const char *path)
     return lub_fsync_dir(dir);
 }
 
+/* The written file tmp made visible as path: flushed to disk before the rename, and the
+ * folder after it (sync_dir); a failure is recorded in c. */
+static void publish(h5ctx *c, const char *tmp, const char *path, int sync_dir)
+{
+    int fd = open(tmp, O_RDONLY);
+    if (fd < 0 || fsync(fd) != 0) fail(c, "cannot sync '%s': %s", tmp, strerror(errno));
+    if (fd >= 0) close(fd);
+    if (!c->failed && rename(tmp, path) != 0)
+        fail(c, "cannot rename '%s': %s", tmp, strerror(errno));
+    if (!c->failed && sync_dir && sync_parent(path) != 0)
+        fail(c, "cannot sync the folder of '%s': %s", path, strerror(errno));
+}
+
 static void write_sidecar(const lub_particles *P, size_t n, const char *dir, int sync_dir);
 
 void lub_particles_writer_write(lub_particles_writer *w, const lub_particles *P, const char *dir)
@@ -530,14 +543,7 @@ void lub_particles_writer_write(lub_particles_writer *w, const lub_particles *P,
     else
         write_contents(&c, P, w->rank, &rw);
     if (!ctx_end(&c)) {
-        /* Flush to disk before the rename makes the file visible, and the folder after. */
-        int fd = open(tmp, O_RDONLY);
-        if (fd < 0 || fsync(fd) != 0) fail(&c, "cannot sync '%s': %s", tmp, strerror(errno));
-        if (fd >= 0) close(fd);
-        if (!c.failed && rename(tmp, path) != 0)
-            fail(&c, "cannot rename '%s': %s", tmp, strerror(errno));
-        if (!c.failed && w->sync_dir && sync_parent(path) != 0)
-            fail(&c, "cannot sync the folder of '%s': %s", path, strerror(errno));
+        publish(&c, tmp, path, w->sync_dir);
     }
     if (c.failed) {
         unlink(tmp);
@@ -623,15 +629,7 @@ void lub_particles_writer_write_rows(lub_particles_writer *w, const lub_particle
     ctx_end(&c); /* the collective close: every rank's rows are in the file after it */
     int failed = c.failed, any = failed;
     MPI_Allreduce(&failed, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
-    if (rank == 0 && !any) {
-        int fd = open(tmp, O_RDONLY);
-        if (fd < 0 || fsync(fd) != 0) fail(&c, "cannot sync '%s': %s", tmp, strerror(errno));
-        if (fd >= 0) close(fd);
-        if (!c.failed && rename(tmp, path) != 0)
-            fail(&c, "cannot rename '%s': %s", tmp, strerror(errno));
-        if (!c.failed && w->sync_dir && sync_parent(path) != 0)
-            fail(&c, "cannot sync the folder of '%s': %s", path, strerror(errno));
-    }
+    if (rank == 0 && !any) publish(&c, tmp, path, w->sync_dir);
     if (any && rank == 0) unlink(tmp);
     if (c.failed) lub_fatal_run("%s: cannot write particle file: %s", path, c.msg);
     if (any) /* the failing rank's message ends the run: this one waits for it */

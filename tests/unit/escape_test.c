@@ -283,21 +283,21 @@ static void test_open_end(void)
 }
 
 /* 3-D: plates at z = 0 and z = 8 l0, periodic in x and y. */
+static const char *plates3 = "dimension: 3\n"
+                             "l0: 0.001\n"
+                             "domain: { min: [0, 0, -0.004], max: [0.008, 0.008, 0.012] }\n"
+                             "periodic: [x, y]\n"
+                             "dummyLayers: 2\n"
+                             "walls:\n"
+                             "  lower: { type: plane, point: [0, 0, 0], normal: [0, 0, 1] }\n"
+                             "  upper: { type: plane, point: [0, 0, 0.008], normal: [0, 0, -1] }\n"
+                             "fluid:\n"
+                             "  - { type: box, min: [0, 0, 0], max: [0.008, 0.008, 0.008] }\n";
+
 static void test_plane_3d(void)
 {
     scene s;
-    scene_open(&s,
-               "dimension: 3\n"
-               "l0: 0.001\n"
-               "domain: { min: [0, 0, -0.004], max: [0.008, 0.008, 0.012] }\n"
-               "periodic: [x, y]\n"
-               "dummyLayers: 2\n"
-               "walls:\n"
-               "  lower: { type: plane, point: [0, 0, 0], normal: [0, 0, 1] }\n"
-               "  upper: { type: plane, point: [0, 0, 0.008], normal: [0, 0, -1] }\n"
-               "fluid:\n"
-               "  - { type: box, min: [0, 0, 0], max: [0.008, 0.008, 0.008] }\n",
-               0);
+    scene_open(&s, plates3, 0);
     const size_t w = wall_near(&s, "lower", (double[3]){0.004, 0.004, 0});
     const size_t i = fluid_near(&s, (double[3]){0.004, 0.004, 0.001});
 #define AT3(a, b, c) {s.P.x[0][w] + (a)*s.l0, s.P.x[1][w] + (b)*s.l0, s.P.x[2][w] + (c)*s.l0}
@@ -506,18 +506,7 @@ static void test_collision_wall_plane(void)
 {
     const double v = 0.1, e = lub_collision_defaults().restitution;
     scene s;
-    scene_open(&s,
-               "dimension: 3\n"
-               "l0: 0.001\n"
-               "domain: { min: [0, 0, -0.004], max: [0.008, 0.008, 0.012] }\n"
-               "periodic: [x, y]\n"
-               "dummyLayers: 2\n"
-               "walls:\n"
-               "  lower: { type: plane, point: [0, 0, 0], normal: [0, 0, 1] }\n"
-               "  upper: { type: plane, point: [0, 0, 0.008], normal: [0, 0, -1] }\n"
-               "fluid:\n"
-               "  - { type: box, min: [0, 0, 0], max: [0.008, 0.008, 0.008] }\n",
-               1);
+    scene_open(&s, plates3, 1);
     const size_t w = wall_near(&s, "lower", (double[3]){0.004, 0.004, 0});
     const size_t i = fluid_near(&s, (double[3]){0.004, 0.004, 0.001});
     const double l0 = s.l0;
