@@ -113,8 +113,11 @@ typedef struct {
     double g[3];   /* without models; the models of a scene add theirs: hooks.forces) */
     int viscosity; /* LUB_VISCOSITY_* */
     double bulk_viscosity, bulk_modulus; /* MPH lambda [Pa s], kappa [Pa] (models/fluid/mph.c) */
-    int viscous_layers; /* MPH: the viscous coefficient 2 (d+2) over lub_mph_layer_quadrature
-                           (viscousNormalisation: layers; 0: the continuum's) */
+    int viscous_layers;       /* MPH: the viscous coefficient 2 (d+2) over lub_mph_layer_quadrature
+                                 (viscousNormalisation: layers; 0: the continuum's) */
+    int divergence_corrected; /* MPH: the bulk viscosity's divergence renormalised, exact
+                                 for linear velocity fields (divergence: corrected; 0:
+                                 Kondo's kernel sum, plain) */
     double patch_velocity[LUB_MAX_PATCHES][3]; /* wall velocities (movingWalls); on a patch
                                                   a model moves: a velocity of its largest
                                                   speed (lubFoam's Courant number), or 0 */

@@ -130,6 +130,105 @@ double lub_mph_layer_quadrature(int dim)
     return (dim + 2) * s;
 }
 
+/* ---- the corrected divergence ----------------------------------------------------------- */
+
+/* (K-7a)'s s_i = sum_j u_ij.g_ij, g_ij = e_ij w_p'(r_ij), is of zeroth order: for a linear
+ * field u_ij = G r_ij it gives sum_ab G_ab M_ba, M_i = sum_j g_ij r_ij^T (symmetric), which
+ * is -tr G only where M_i = -I.  On the lattice interior M = -0.998 I (2-D), but on rows of
+ * particles shifted against each other, as a shear flow leaves them, M_i is not isotropic
+ * and a shear (tr G = 0) gets s != 0: lambda s^2 dissipates where the continuum's bulk
+ * viscosity does nothing.  With lambda >> mu (a squeeze film's 1e5 mu) the sheared packing
+ * locks: plane Poiseuille flow on the lattice at lambda = 1e4 Pa s, mu 0.1 Pa s stalls at
+ * 5-10% of its flux for tens of ms at a time (doc/methods.md §8, Accuracy).
+ *
+ * divergence: corrected takes s_i = sum_j u_ij.B_i g_ij, B_i = -M_i^-1 (symmetric), which is
+ * -div u exactly for every linear field on any arrangement.  The bulk dissipation (lambda/2)
+ * sum_i s_i^2 dV is still a quadratic form, positive semi-definite (energy only decreases);
+ * sum_a ds_i/du_a = 0 (differences u_j - u_i: momentum kept); and s_i of a rigid rotation
+ * u = W x (W antisymmetric) is -tr W = 0 (angular momentum kept).  The force on a is
+ * -lambda dV sum_i s_i ds_i/du_a = dV sum_j lambda (s_a B_a + s_j B_j) g_aj, antisymmetric in
+ * a, j.  Where M_i is too deficient to invert (a particle with neighbours on a line or none:
+ * its smallest eigenvalue of -M below CORR_MIN of the lattice's), B_i = I, the plain sum,
+ * which keeps all three properties too (g_ij parallel to r_ij). */
+#define CORR_MIN 0.2
+
+/* m0: -M = m0 I on the lattice interior, m0 = sum_j r_j (-w_p'(r_j)) / d (l0 = 1). */
+static double lattice_m(int dim)
+{
+    const double h = LUB_MPH_HP;
+    const int k = (int)ceil(h), kz = dim == 3 ? k : 0;
+    double s = 0;
+    for (int a = -k; a <= k; a++)
+        for (int b = -k; b <= k; b++)
+            for (int c = -kz; c <= kz; c++) {
+                const double r = sqrt((double)(a * a + b * b + c * c));
+                if (r > 0 && r < h) s -= r * lub_mph_dw(dim, 1.0, h, r);
+            }
+    return s / dim;
+}
+
+/* B = -M^-1 for the symmetric M (row-major 3 x 3, dim x dim used), or I where the smallest
+ * eigenvalue of -M is below CORR_MIN m0. */
+static void correction(int dim, const double M[9], double m0, double B[9])
+{
+    double A[9]; /* -M */
+    for (int k = 0; k < 9; k++) A[k] = -M[k], B[k] = 0.0;
+    double lmin;
+    if (dim == 2) {
+        const double t = 0.5 * (A[0] + A[4]), d = 0.5 * (A[0] - A[4]);
+        lmin = t - sqrt(d * d + A[1] * A[1]);
+    } else { /* the symmetric 3 x 3 eigenvalues by the trigonometric formula */
+        const double p1 = A[1] * A[1] + A[2] * A[2] + A[5] * A[5];
+        const double q = (A[0] + A[4] + A[8]) / 3.0;
+        const double p2 =
+            (A[0] - q) * (A[0] - q) + (A[4] - q) * (A[4] - q) + (A[8] - q) * (A[8] - q) + 2.0 * p1;
+        const double p = sqrt(p2 / 6.0);
+        if (p == 0) {
+            lmin = q;
+        } else {
+            double C[9];
+            for (int k = 0; k < 9; k++) C[k] = (A[k] - (k % 4 == 0 ? q : 0.0)) / p;
+            const double det = C[0] * (C[4] * C[8] - C[5] * C[7]) -
+                               C[1] * (C[3] * C[8] - C[5] * C[6]) +
+                               C[2] * (C[3] * C[7] - C[4] * C[6]);
+            const double r = fmax(-1.0, fmin(1.0, det / 2.0));
+            lmin = q + 2.0 * p * cos(acos(r) / 3.0 + 2.0 * M_PI / 3.0);
+        }
+    }
+    if (!(lmin > CORR_MIN * m0)) {
+        B[0] = B[4] = B[8] = 1.0;
+        return;
+    }
+    if (dim == 2) {
+        const double det = A[0] * A[4] - A[1] * A[3];
+        B[0] = A[4] / det, B[4] = A[0] / det;
+        B[1] = -A[1] / det, B[3] = -A[3] / det;
+        B[8] = 1.0;
+        return;
+    }
+    const double c0 = A[4] * A[8] - A[5] * A[7], c1 = A[5] * A[6] - A[3] * A[8],
+                 c2 = A[3] * A[7] - A[4] * A[6];
+    const double det = A[0] * c0 + A[1] * c1 + A[2] * c2;
+    B[0] = c0 / det, B[1] = (A[2] * A[7] - A[1] * A[8]) / det,
+    B[2] = (A[1] * A[5] - A[2] * A[4]) / det;
+    B[3] = c1 / det, B[4] = (A[0] * A[8] - A[2] * A[6]) / det,
+    B[5] = (A[2] * A[3] - A[0] * A[5]) / det;
+    B[6] = c2 / det, B[7] = (A[1] * A[6] - A[0] * A[7]) / det,
+    B[8] = (A[0] * A[4] - A[1] * A[3]) / det;
+}
+
+/* out = B_i v (v itself with the plain sum) */
+static inline void bmul(const double *B, size_t i, const double v[3], double out[3])
+{
+    if (!B) {
+        for (int d = 0; d < 3; d++) out[d] = v[d];
+        return;
+    }
+    const double *b = B + 9 * i;
+    for (int d = 0; d < 3; d++)
+        out[d] = b[3 * d] * v[0] + b[3 * d + 1] * v[1] + b[3 * d + 2] * v[2];
+}
+
 /* ---- the formulation's state ------------------------------------------------------------ */
 
 typedef struct {
@@ -147,6 +246,9 @@ typedef struct {
     size_t blk_cap;    /* blocks they hold (grown with the lists, rarely after the first steps) */
     size_t nfar;       /* bulk pairs (a, b) beyond the lists (none expected; counted) */
     double *pload;     /* the particle field pLoad (wall particles; see wall_load) */
+    double *B;         /* divergence: corrected: B_i (3 x 3 per particle, row-major), NULL
+                          with the plain sum (B_i = I; see correction) */
+    double m0;         /* the lattice interior's -M = m0 I (correction) */
 } mph_state;
 
 static void state_free(void *p)
@@ -161,6 +263,7 @@ static void state_free(void *p)
     free(S->pos);
     free(S->blkp);
     free(S->blk);
+    free(S->B);
     free(S);
 }
 
@@ -183,6 +286,10 @@ static mph_state *state(lub_mps *m)
     S->pos = lub_malloc(n * sizeof(int));
     for (size_t i = 0; i < n; i++) S->pos[i] = -1;
     S->pload = lub_particles_extra(m->P, "pLoad");
+    if (m->c.divergence_corrected) {
+        S->B = lub_calloc(9 * n, sizeof(double));
+        S->m0 = lattice_m(m->dim);
+    }
     m->fstate = S;
     m->fstate_free = state_free;
     if (m->c.list_l0 < LUB_MPH_HV)
@@ -227,7 +334,7 @@ static void density(lub_mps *m, mph_state *S)
     const double kappa = m->c.bulk_modulus, l0 = m->l0;
 #pragma omp parallel for schedule(static) if (P->n >= LUB_LINALG_OMP_MIN)
     for (size_t i = 0; i < P->n; i++) {
-        double n = 0, G[3] = {0, 0, 0};
+        double n = 0, G[3] = {0, 0, 0}, M[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
         for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
             double e[3];
             const double r = pair_r(nb, q, dim, e);
@@ -235,9 +342,13 @@ static void density(lub_mps *m, mph_state *S)
             n += lub_mph_w(dim, l0, S->hp, r);
             const double dw = lub_mph_dw(dim, l0, S->hp, r);
             for (int d = 0; d < dim; d++) G[d] += e[d] * dw;
+            if (S->B) /* M_i = sum_j g_ij r_ij^T */
+                for (int a = 0; a < dim; a++)
+                    for (int b = 0; b < dim; b++) M[3 * a + b] += e[a] * e[b] * dw * r;
         }
         m->pnd[i] = n;
         for (int d = 0; d < 3; d++) S->G[d][i] = G[d];
+        if (S->B) correction(dim, M, S->m0, S->B + 9 * i);
         S->pk[i] = kappa * fmax(n - S->n0, 0.0);
     }
 }
@@ -250,17 +361,44 @@ static void divergence(lub_mps *m, mph_state *S, double *s)
     const int dim = m->dim;
 #pragma omp parallel for schedule(static) if (P->n >= LUB_LINALG_OMP_MIN)
     for (size_t i = 0; i < P->n; i++) {
-        double v = 0;
+        double T[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}; /* sum_j u_ij g_ij^T */
         for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
             double e[3];
             const double r = pair_r(nb, q, dim, e);
             if (!(r < S->hp) || r == 0) continue;
             const size_t j = nb->j[q];
             const double dw = lub_mph_dw(dim, m->l0, S->hp, r);
-            for (int d = 0; d < dim; d++) v += (P->u[d][j] - P->u[d][i]) * e[d] * dw;
+            for (int a = 0; a < dim; a++)
+                for (int b = 0; b < dim; b++) T[3 * a + b] += (P->u[a][j] - P->u[a][i]) * e[b] * dw;
+        }
+        double v = 0; /* sum_j u_ij.B_i g_ij = sum_ab T_ab B_ab (B symmetric) */
+        for (int a = 0; a < dim; a++) {
+            if (!S->B) v += T[4 * a];
+            for (int b = 0; S->B && b < dim; b++) v += T[3 * a + b] * S->B[9 * i + 3 * a + b];
         }
         s[i] = v;
     }
+}
+
+/* The pressure pair force per dV on particle i from its neighbour j (e = e_ij, dw =
+ * w_p'(r_ij)), as the step gave it: (P_i + P_j) g_ij with the plain sum, (P^kap_i + P^kap_j)
+ * g_ij + lambda (s_i B_i + s_j B_j) g_ij with the corrected one (s, P at u^{k+1}). */
+static void pair_pressure(const lub_mps *m, const mph_state *S, size_t i, size_t j,
+                          const double e[3], double dw, double f[3])
+{
+    const lub_particles *P = m->P;
+    double g[3];
+    for (int d = 0; d < 3; d++) g[d] = e[d] * dw;
+    if (!S->B) {
+        for (int d = 0; d < 3; d++) f[d] = (P->p[i] + P->p[j]) * g[d];
+        return;
+    }
+    double bi[3], bj[3];
+    bmul(S->B, i, g, bi);
+    bmul(S->B, j, g, bj);
+    const double lam = m->c.bulk_viscosity;
+    for (int d = 0; d < 3; d++)
+        f[d] = (S->pk[i] + S->pk[j]) * g[d] + lam * (S->s[i] * bi[d] + S->s[j] * bj[d]);
 }
 
 /* Step 5: assemble the SPD system of the fluid velocities (see the top of the file) into
@@ -339,32 +477,35 @@ static int assemble(lub_mps *m, mph_state *S, double dt)
             for (size_t qa = nb->start[a]; qa <= nb->end[a]; qa++) {
                 size_t i;
                 double Dia[3] = {0, 0, 0};
-                if (qa == nb->end[a]) { /* i = a: D_aa = -G_a */
+                double v[3] = {0, 0, 0};
+                if (qa == nb->end[a]) { /* i = a: D_aa = -B_a G_a */
                     i = a;
-                    for (int c = 0; c < dim; c++) Dia[c] = -S->G[c][a];
+                    for (int c = 0; c < dim; c++) v[c] = -S->G[c][a];
                 } else {
                     double e[3];
                     const double rr = pair_r(nb, qa, dim, e);
                     if (!(rr < S->hp) || rr == 0) continue;
                     i = nb->j[qa];
-                    /* D_ia = g_ia = e_ia w'(r), e_ia = -e_ai */
+                    /* D_ia = B_i g_ia, g_ia = e_ia w'(r), e_ia = -e_ai */
                     const double dw = lub_mph_dw(dim, l0, S->hp, rr);
-                    for (int c = 0; c < dim; c++) Dia[c] = -e[c] * dw;
+                    for (int c = 0; c < dim; c++) v[c] = -e[c] * dw;
                 }
+                bmul(S->B, i, v, Dia);
                 for (size_t qi = nb->start[i]; qi <= nb->end[i]; qi++) {
                     size_t b;
-                    double Dib[3] = {0, 0, 0};
+                    double Dib[3], v2[3] = {0, 0, 0};
                     if (qi == nb->end[i]) {
                         b = i;
-                        for (int c = 0; c < dim; c++) Dib[c] = -S->G[c][i];
+                        for (int c = 0; c < dim; c++) v2[c] = -S->G[c][i];
                     } else {
                         double e[3];
                         const double rr = pair_r(nb, qi, dim, e);
                         if (!(rr < S->hp) || rr == 0) continue;
                         b = nb->j[qi];
                         const double dw = lub_mph_dw(dim, l0, S->hp, rr);
-                        for (int c = 0; c < dim; c++) Dib[c] = e[c] * dw;
+                        for (int c = 0; c < dim; c++) v2[c] = e[c] * dw;
                     }
+                    bmul(S->B, i, v2, Dib);
                     if (P->kind[b] == LUB_FLUID) {
                         if (S->pos[b] < 0) { /* beyond the lists: cannot be (2 h_p = h_v) */
                             S->nfar++;
@@ -434,8 +575,9 @@ static void wall_load(lub_mps *m, mph_state *S)
                 for (int d = 0; d < dim; d++) c[d] += nb->dx[d][q];
                 nc++;
             } else if (r < S->hp) {
-                const double f = (P->p[i] + P->p[j]) * lub_mph_dw(dim, m->l0, S->hp, r) * dV;
-                for (int d = 0; d < dim; d++) F[d] += f * e[d];
+                double f[3];
+                pair_pressure(m, S, i, j, e, lub_mph_dw(dim, m->l0, S->hp, r), f);
+                for (int d = 0; d < dim; d++) F[d] += f[d] * dV;
             }
         }
         double nn = 0, fn = 0;
@@ -653,9 +795,9 @@ static void mph_wall_forces(const lub_mps *m, int patch, double *const area[3],
             const double cv = visc * lub_mph_dw(dim, m->l0, S->hv, r) / r;
             double ue = 0;
             for (int d = 0; d < dim; d++) ue += (P->u[d][b] - P->u[d][a]) * e[d];
-            const double fp =
-                r < S->hp ? (P->p[b] + P->p[a]) * lub_mph_dw(dim, m->l0, S->hp, r) : 0.0;
-            for (int d = 0; d < dim; d++) F[d] += (fp - cv * ue) * e[d];
+            double fp[3] = {0, 0, 0};
+            if (r < S->hp) pair_pressure(m, S, b, a, e, lub_mph_dw(dim, m->l0, S->hp, r), fp);
+            for (int d = 0; d < dim; d++) F[d] += fp[d] - cv * ue * e[d];
         }
         for (int d = 0; d < dim; d++)
             f[d][b] = F[d] * dV + (m->pacc[d] ? mass * m->pacc[d][b] : 0.0);
@@ -676,6 +818,10 @@ static void mph_read(lub_mps_config *c, const lub_case *cs, lub_node *models, lu
      * in 2-D): 'layers' divides by that (methods.md §8, Accuracy) */
     static const char *const norms[] = {"continuum", "layers", NULL};
     c->viscous_layers = lub_dict_choice(entry, "viscousNormalisation", norms, 0) == 1;
+    /* the bulk viscosity's divergence: Kondo's kernel sum, or renormalised so that a shear
+     * on any arrangement has none (correction, methods.md §8) */
+    static const char *const divs[] = {"plain", "corrected", NULL};
+    c->divergence_corrected = lub_dict_choice(entry, "divergence", divs, 0) == 1;
     lub_node *v = lub_dict_find(models, "viscosity");
     if (v)
         lub_node_error(v, "'viscosity' belongs to the fluid 'mps'; the fluid 'mph' takes its "
@@ -701,6 +847,12 @@ static void mph_header_level(const lub_mps *m)
                 "mu %g Pa s, bulkViscosity lambda %g Pa s, bulkModulus kappa %g Pa",
                 m->l0, LUB_MPH_HP * m->l0, LUB_MPH_HV * m->l0, lub_mph_n0(m->dim, m->l0), m->c.rho,
                 m->c.rho * m->c.nu, m->c.bulk_viscosity, m->c.bulk_modulus);
+    lub_message("MPH: divergence %s",
+                m->c.divergence_corrected
+                    ? "corrected (the bulk viscosity's s_i = sum_j u_ij.B_i g_ij, B_i = "
+                      "-(sum_j g_ij r_ij^T)^-1: exact for linear fields, no bulk dissipation "
+                      "in a shear)"
+                    : "plain (Kondo's s_i = sum_j u_ij.g_ij of (K-7a))");
     if (m->c.viscous_layers)
         lub_message("MPH: viscousNormalisation layers: the viscous coefficient 2 (d+2) over "
                     "%.6f, its response to a shear across layers l0 apart",

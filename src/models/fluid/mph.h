@@ -15,6 +15,10 @@
  *   6. P_i = P^kap_i + lambda sum_j (u_ij.e_ij) w_p'_ij (K-7a) of every particle, walls
  *      included (their load: probe wallPressure)
  *
+ * divergence: corrected replaces the sum s_i = sum_j u_ij.g_ij of the bulk viscosity by
+ * sum_j u_ij.B_i g_ij, B_i = -(sum_j g_ij r_ij^T)^-1, exact for linear fields (mph.c,
+ * correction): a shear on shifted rows then dissipates nothing through lambda.
+ *
  * Walls (the seed is silent, as Kondo's code): wall and dummy particles alike count in n_i,
  * carry their prescribed velocity, get P from (K-7a) and exchange the same pair forces; the
  * wall must be at least h_v thick (a wall layer and 3 dummy layers: particleGenDict

@@ -47,6 +47,7 @@
  *
  * Both fluids call it with the explicit forces (particle_forces, models/model.h); the lists
  * must reach h_s = 3.5 l0 (configure: list_l0). */
+#include <errno.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -507,6 +508,42 @@ static void st_header(const lub_model *m, const lub_scene *s)
                 S->a_energy * S->tension1 / S->sigma, len ? walls : "none");
 }
 
+/* postProcessing/surfaceTension/<start>/constants.yaml: the model's constants as this run
+ * computed them, a dictionary for scripts to read by key (lubDict FILE a), written
+ * atomically at the start of every run (the header's line says the same in prose) */
+static void st_functions_start(lub_model *m, lub_scene *s, const char *start, double t)
+{
+    (void)t;
+    const surface *S = m->state;
+    char path[LUB_PATH_MAX];
+    lub_postproc_path(s->cs, "surfaceTension", start, "constants.yaml", path);
+    lub_atomic_file af;
+    FILE *fp = lub_atomic_open(&af, path);
+    if (!fp) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+    fprintf(fp, "# surfaceTension's constants (doc/methods.md 9), as lubFoam computed them at "
+                "the start of the run\n");
+    fprintf(fp, "sigma:         %.17g  # [N/m]\n", S->sigma);
+    fprintf(fp,
+            "a:             %.17g  # [Pa] (K-7b)'s coefficient: the flat lattice "
+            "interface pulls sigma\n",
+            S->a);
+    fprintf(fp, "aEnergy:       %.17g  # [Pa] Kondo's calibration to the energy\n", S->a_energy);
+    fprintf(fp, "k:             %.17g  # DGP over CPP\n", S->k);
+    fprintf(fp, "hs:            %.17g  # [m] the kernels' radius h_s = 3.5 l0\n", S->hs);
+    fprintf(fp, "n0a:           %.17g  # n^a on the lattice interior\n", S->n0a);
+    fprintf(fp,
+            "cohesiveLimit: %.17g  # [Pa] a n0^a: -pCohesive of a particle with no "
+            "neighbour, the most tension CPP carries\n",
+            S->a * S->n0a);
+    fprintf(fp, "wallFactor:\n");
+    for (int p = 0; p < s->P->npatches; p++) {
+        fprintf(fp, "  %s: %.17g", s->P->patch_names[p], S->c[p]);
+        if (!isnan(S->theta[p])) fprintf(fp, "  # contactAngle %g degrees", S->theta[p]);
+        fputc('\n', fp);
+    }
+    if (lub_atomic_close(&af) != 0) lub_fatal_run("cannot write '%s': %s", path, strerror(errno));
+}
+
 static void st_free(lub_model *m)
 {
     surface *S = m->state;
@@ -524,6 +561,7 @@ const lub_model_type lub_model_surfaceTension = {
     .init = st_init,
     .describe = st_describe,
     .header = st_header,
+    .functions_start = st_functions_start,
     .particle_forces = st_particle_forces,
     .free = st_free,
 };
