@@ -31,6 +31,18 @@ double lub_load_average(const char *path, int *runnable)
     return load;
 }
 
+long lub_peak_memory_kb(const char *path)
+{
+    FILE *f = fopen(path ? path : "/proc/self/status", "r");
+    if (!f) return -1;
+    char line[256];
+    long kb = -1;
+    while (kb < 0 && fgets(line, sizeof line, f))
+        if (sscanf(line, "VmHWM: %ld kB", &kb) != 1) kb = -1;
+    fclose(f);
+    return kb;
+}
+
 double lub_load_now(double average, int others)
 {
     if (!(average >= 0)) return -1.0;

@@ -39,6 +39,9 @@ static inline void lub_timer_stop(lub_timers *t, int k)
  * where it cannot be read; and in *runnable (may be NULL) the tasks runnable at the moment
  * of reading (R of its fourth field R/T, which counts the reader), or -1. */
 double lub_load_average(const char *path, int *runnable);
+/* The peak resident memory of this process in kB (VmHWM of /proc/self/status; path: a file
+ * of its format, NULL: that one), or -1 where it cannot be read. */
+long lub_peak_memory_kb(const char *path);
 /* The load other work puts on the machine now: the 1-minute average, but no more than the
  * `others` tasks of other programs runnable at this moment (-1: unknown).  The average lags:
  * it still reads 1.5 a few seconds after a two-thread run has ended, which alone made every

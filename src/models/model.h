@@ -143,6 +143,9 @@ struct lub_scene {
     int nr;                          /* steps of the finest level per step of the scene */
     long dt_factor[LUB_MAX_LEVELS];  /* a level's dt over the finest level's */
     lub_mps single;                  /* without a driver: the solver */
+    lub_par *par; /* a run on several ranks (parallel/par.h; NULL: serial): the particles are
+                     this rank's slab, the models' start-up checks are collective; set before
+                     lub_scene_build, which gives it to the solver before the models' init */
 
     /* set-up (lub_scene_build) */
     char state_path[LUB_PATH_MAX]; /* the start folder's uniform/state.yaml (may not exist) */
@@ -163,7 +166,8 @@ void lub_scene_read(lub_scene *s, const lub_case *cs, lub_particles *P, const lu
                     lub_mps_config *c);
 /* Build the fluid's solvers from c (the driver's build, else one solver for the particles;
  * particles of several levels need a driver), attach the models' in-step operations to them
- * (mps.h hooks) and call every model's init.  state_path: the start folder's
+ * (mps.h hooks), on several ranks (s->par) give the solver the decomposition
+ * (lub_mps_set_parallel), and call every model's init.  state_path: the start folder's
  * uniform/state.yaml (may not exist); end_time > 0: the run's end time, named end_what in
  * messages. */
 void lub_scene_build(lub_scene *s, const lub_mps_config *c, const char *state_path, double end_time,

@@ -115,6 +115,10 @@ void lub_scene_build(lub_scene *s, const lub_mps_config *c, const char *state_pa
     if (s->nlevels < 1 || s->nlevels > LUB_MAX_LEVELS || s->nr < 1)
         lub_bug("lub_scene_build: %d levels, %d steps per step", s->nlevels, s->nr);
     attach(s, s->level, s->nlevels);
+    if (s->par) {
+        if (s->nlevels != 1) lub_bug("lub_scene_build: %d levels on several ranks", s->nlevels);
+        lub_mps_set_parallel(s->level[0], s->par);
+    }
     /* the models' restart state: each model reads its entry of the start's state.yaml */
     lub_dict *st = state_path ? lub_dict_read_optional(state_path) : NULL;
     s->state = st ? lub_dict_root(st) : NULL;

@@ -285,15 +285,24 @@ struct lub_mps {
 void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const double lo[3],
                   const double hi[3], const int periodic[3]);
 void lub_mps_free(lub_mps *m);
+/* The neighbour lists' radius re (1 + skin) of a solver of configuration c and spacing l0
+ * (the halo of a rank: parallel/par.h). */
+double lub_mps_list_radius(const lub_mps_config *c, double l0);
+/* Every per-particle array of the solver and the particles P to capacity cap (nothing when
+ * cap <= m->cap), their contents kept: one allocation between steps, when the particles of
+ * a rank's slab outgrow it (lub_mps_set_parallel). */
+void lub_mps_resize(lub_mps *m, size_t cap);
 
 /* Solve on several ranks (parallel/par.h): this rank's particles are P's first d->nown
- * (lub_par_decompose done).  Each step then migrates, builds the halo, refreshes it after
+ * (lub_par_distribute done).  Each step then migrates, builds the halo, refreshes it after
  * each phase whose result a neighbour reads (u* after the viscous step, the free-surface
  * flags, the global rows of the unknowns, the pressure after the solve), solves the pressure
  * and viscosity equations over all ranks (a distributed CSR: linalg/csr.h, PETSc only) and
  * leaves P->n = d->nown.  The step's status, statistics and the largest speed are those of
- * all ranks.  Refused here (lub_bug; lubFoam refuses them first): the LSMPS Laplacians,
- * given particles (multiResolution), a formulation with its own step. */
+ * all ranks.  A migration or halo beyond the capacity re-sizes the solver and the particles
+ * (d->grow: lub_mps_resize for the count and d->margin again, with a warning).  Refused here
+ * (lub_bug; lubFoam refuses them first): the LSMPS Laplacians, given particles
+ * (multiResolution), a formulation with its own step. */
 void lub_mps_set_parallel(lub_mps *m, lub_par *d);
 
 /* Status of a step. */

@@ -30,6 +30,22 @@ static void *alloc_doubles(size_t n)
     return lub_calloc(n ? n : 1, sizeof(double));
 }
 
+/* The neighbour lists' skin: lists reaching list_l0 l0 beyond re (a formulation's or a
+ * model's wider kernel) have a larger one, the weights still of re (pairs beyond re stored
+ * with w = 0). */
+static double list_skin(const lub_mps_config *c, double l0)
+{
+    const double re = c->re_l0 * l0;
+    double skin = c->skin;
+    if (c->list_l0 * l0 > re * (1 + skin)) skin = c->list_l0 * l0 / re - 1;
+    return skin;
+}
+
+double lub_mps_list_radius(const lub_mps_config *c, double l0)
+{
+    return c->re_l0 * l0 * (1.0 + list_skin(c, l0)); /* lub_neighbours' rs */
+}
+
 void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const double lo[3],
                   const double hi[3], const int periodic[3])
 {
@@ -54,11 +70,7 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
         m->hi[d] = hi[d];
         m->periodic[d] = periodic[d];
     }
-    /* lists reaching list_l0 l0 beyond re (a formulation's or a model's wider kernel): a
-     * larger skin, the weights still of re (pairs beyond re stored with w = 0) */
-    double skin = c->skin;
-    if (c->list_l0 * m->l0 > m->re * (1 + skin)) skin = c->list_l0 * m->l0 / m->re - 1;
-    lub_neighbours_init(&m->nb, m->dim, m->re, skin, lo, hi, periodic);
+    lub_neighbours_init(&m->nb, m->dim, m->re, list_skin(c, m->l0), lo, hi, periodic);
     lub_neighbours_set_order(&m->nb, c->order_rows ? m->l0 : 0.0);
     lub_csr_init(&m->A);
     lub_csr_init(&m->A2);
@@ -204,12 +216,79 @@ void lub_mps_relist(lub_mps *m)
     neighbours(m, 1);
 }
 
+/* One per-particle array from m->cap to cap elements (NULL stays NULL), the new tail zeroed
+ * as lub_mps_init's calloc left it. */
+static void *regrow(void *a, size_t old, size_t cap, size_t size)
+{
+    if (!a) return NULL;
+    char *b = lub_realloc(a, cap * size);
+    memset(b + old * size, 0, (cap - old) * size);
+    return b;
+}
+
+void lub_mps_resize(lub_mps *m, size_t cap)
+{
+    if (cap <= m->cap) return;
+    if (m->fstate) lub_bug("lub_mps_resize: a formulation's own arrays (not re-sized)");
+    const size_t old = m->cap;
+    lub_particles *P = m->P;
+    lub_particles_reserve(P, cap);
+    for (int d = 0; d < 3; d++) {
+        m->us[d] = regrow(m->us[d], old, cap, sizeof(double));
+        m->bv[d] = regrow(m->bv[d], old, cap, sizeof(double));
+        m->xv[d] = regrow(m->xv[d], old, cap, sizeof(double));
+        m->grad[d] = regrow(m->grad[d], old, cap, sizeof(double));
+        m->kap[d] = regrow(m->kap[d], old, cap, sizeof(double));
+        m->pacc[d] = regrow(m->pacc[d], old, cap, sizeof(double));
+    }
+    m->pnd = regrow(m->pnd, old, cap, sizeof(double));
+    m->div = regrow(m->div, old, cap, sizeof(double));
+    m->lap = regrow(m->lap, old, cap, sizeof(double));
+    m->b = regrow(m->b, old, cap, sizeof(double));
+    m->x = regrow(m->x, old, cap, sizeof(double));
+    m->surface = regrow(m->surface, old, cap, 1);
+    m->anchor = regrow(m->anchor, old, cap, 1);
+    m->lapflag = regrow(m->lapflag, old, cap, 1);
+    m->row = regrow(m->row, old, cap, sizeof *m->row);
+    m->prow = regrow(m->prow, old, cap, sizeof *m->prow);
+    m->scratch = regrow(m->scratch, old, cap, sizeof(double));
+    m->fixed = regrow(m->fixed, old, cap, 1);
+    m->inside = regrow(m->inside, old, cap, 1);
+    m->gidx = regrow(m->gidx, old, cap, sizeof(double));
+    m->colmap = regrow(m->colmap, old, cap, sizeof *m->colmap);
+    m->conn = regrow(m->conn, old, cap, 1);
+    /* the solver's fields kept in the particles (their extra fields) moved with them */
+    static const char *const gbar_names[3] = {"gradPx", "gradPy", "gradPz"};
+    for (int d = 0; d < 3; d++)
+        if (m->gbar[d]) m->gbar[d] = lub_particles_find_extra(P, gbar_names[d]);
+    if (m->cav) m->cav = lub_particles_find_extra(P, "cavitation");
+    if (m->surf) m->surf = lub_particles_find_extra(P, "surface");
+    m->cap = cap;
+}
+
+/* The halo or the migration would overfill the slab (lub_par.grow): the particles and the
+ * solver's arrays re-sized once for n and the margin again, between steps (the exchanges
+ * come first in a step, before any array of the step is formed), and said. */
+static void grow_slab(void *ctx, size_t n, const char *what)
+{
+    lub_mps *m = ctx;
+    const size_t old = m->cap, cap = n + (size_t)ceil(m->par->margin * (double)n);
+    lub_mps_resize(m, cap);
+    lub_warning("step %ld: the %s brings %zu particles to this rank, beyond its capacity %zu: "
+                "the particles and the solver's arrays re-sized to %zu (the slab's count and "
+                "the margin %g again; balance in system/decomposeParDict.yaml keeps the slabs "
+                "even)",
+                m->steps + 1, what, n, old, cap, m->par->margin);
+}
+
 void lub_mps_set_parallel(lub_mps *m, lub_par *d)
 {
     if (m->fixed || m->c.lap_pressure == LUB_LAPLACIAN_LSMPS ||
         m->c.lap_viscosity == LUB_LAPLACIAN_LSMPS)
         lub_bug("lub_mps_set_parallel: given particles or an LSMPS Laplacian (not parallel)");
     m->par = d;
+    d->grow = grow_slab;
+    d->grow_ctx = m;
     if (!m->gidx) {
         m->gidx = alloc_doubles(m->cap);
         m->colmap = lub_calloc(m->cap ? m->cap : 1, sizeof *m->colmap);

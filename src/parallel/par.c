@@ -42,6 +42,7 @@ void lub_par_read_dict(lub_par_dict *pd, const char *path, int dim, int nranks)
     pd->interval = lub_dict_int_or(bl, "interval", 0, 0, 1L << 40);
     pd->imbalance = lub_dict_real_or(bl, "imbalance", 0.1, LUB_NONNEGATIVE);
     pd->write = lub_dict_choice(root, "writeParticles", writes, 0);
+    pd->margin = lub_dict_real_or(root, "margin", 0.2, LUB_NONNEGATIVE);
     if (pd->write == LUB_PAR_WRITE_COLLECTIVE && !lub_particles_collective())
         lub_node_error(lub_dict_find(root, "writeParticles"),
                        "writeParticles collective, but this lubkit was built with the serial "
@@ -107,6 +108,10 @@ void lub_par_sum_longs(long *a, size_t n)
 {
     (void)a, (void)n;
 }
+void lub_par_min_doubles(double *a, size_t n)
+{
+    (void)a, (void)n;
+}
 void lub_par_bcast_text(char *text, size_t size, int root)
 {
     (void)text, (void)size, (void)root;
@@ -131,10 +136,39 @@ int lub_par_longest_axis(const lub_particles *P)
     (void)P;
     NO_MPI("lub_par_longest_axis")
 }
-size_t lub_par_decompose(lub_par *d, lub_particles *P)
+void lub_par_quantiles(const double *x, size_t n, int parts, double *cut)
+{
+    (void)x, (void)n, (void)parts, (void)cut;
+    NO_MPI("lub_par_quantiles")
+}
+size_t lub_par_distribute(lub_par *d, const lub_particles *S, const uint64_t *place,
+                          lub_particles *P, const char *path)
+{
+    (void)d, (void)S, (void)place, (void)P, (void)path;
+    NO_MPI("lub_par_distribute")
+}
+size_t lub_par_halo_count(lub_par *d, const lub_particles *P)
 {
     (void)d, (void)P;
-    NO_MPI("lub_par_decompose")
+    NO_MPI("lub_par_halo_count")
+}
+void lub_par_collect(lub_par *d, const lub_particles *P, double width, const uint8_t *want,
+                     lub_particles *Q)
+{
+    (void)d, (void)P, (void)width, (void)want, (void)Q;
+    NO_MPI("lub_par_collect")
+}
+void lub_par_raise(int status, const char *msg)
+{
+    if (msg) {
+        if (status == LUB_EXIT_RUN) lub_fatal_run("%s", msg);
+        lub_fatal("%s", msg);
+    }
+}
+long lub_par_peak_memory(long kb, long *least, long *mean)
+{
+    *least = *mean = kb;
+    return kb;
 }
 int lub_par_owner(const lub_par *d, double x)
 {
@@ -180,12 +214,6 @@ size_t lub_par_rows(lub_par *d, const lub_particles *P, lub_particles *R, uint64
 {
     (void)d, (void)P, (void)R, (void)place;
     NO_MPI("lub_par_rows")
-}
-void lub_par_assemble(const lub_particles *S, const uint64_t *place, size_t n, lub_particles *P,
-                      const char *path)
-{
-    (void)S, (void)place, (void)n, (void)P, (void)path;
-    NO_MPI("lub_par_assemble")
 }
 
 #else
@@ -297,6 +325,11 @@ void lub_par_sum_longs(long *a, size_t n)
 {
     if (started && n > 0) MPI_Allreduce(MPI_IN_PLACE, a, (int)n, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
 }
+void lub_par_min_doubles(double *a, size_t n)
+{
+    if (started && n > 0)
+        MPI_Allreduce(MPI_IN_PLACE, a, (int)n, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+}
 long lub_par_exscan(long v)
 {
     long r = 0;
@@ -332,6 +365,7 @@ void lub_par_init(lub_par *d, int axis, double width, double lo, double hi, int 
     d->rank = rank_;
     d->size = size_;
     d->cut = lub_calloc((size_t)size_ + 1, sizeof *d->cut);
+    d->sel = lub_calloc(3 * ((size_t)size_ + 1), sizeof *d->sel);
     int **a[] = {&d->scount, &d->sdispl,  &d->rcount, &d->rdispl,
                  &d->mcount, &d->mrcount, &d->mdispl, &d->mrdispl};
     for (size_t k = 0; k < sizeof a / sizeof *a; k++)
@@ -346,7 +380,8 @@ void lub_par_free(lub_par *d)
     free(d->sidx);
     free(d->sbuf);
     free(d->rbuf);
-    free(d->coord);
+    free(d->keys);
+    free(d->sel);
     memset(d, 0, sizeof *d);
 }
 
@@ -360,6 +395,8 @@ int lub_par_longest_axis(const lub_particles *P)
             hi[k] = fmax(hi[k], P->x[k][i]);
         }
     }
+    MPI_Allreduce(MPI_IN_PLACE, lo, 3, MPI_DOUBLE, MPI_MIN, MPI_COMM_WORLD);
+    MPI_Allreduce(MPI_IN_PLACE, hi, 3, MPI_DOUBLE, MPI_MAX, MPI_COMM_WORLD);
     int axis = 0;
     for (int k = 1; k < P->dim; k++)
         if (hi[k] - lo[k] > hi[axis] - lo[axis]) axis = k;
@@ -379,12 +416,6 @@ int lub_par_owner(const lub_par *d, double x)
     return a;
 }
 
-static int cmp_double(const void *a, const void *b)
-{
-    const double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 /* Move particle i to k (k <= i) in every array of P. */
 static void move_particle(lub_particles *P, size_t k, size_t i)
 {
@@ -401,47 +432,112 @@ static void move_particle(lub_particles *P, size_t k, size_t i)
     for (int e = 0; e < P->nextra; e++) P->extra[e].v[k] = P->extra[e].v[i];
 }
 
-/* The cuts at the quantiles of the n coordinates s (sorted here): rank r from the
- * (r n / size)-th coordinate on; equal coordinates (a lattice's column) stay together, on
- * the rank of their first. */
-static void cut_at_quantiles(lub_par *d, double *s, size_t n)
+/* ---- the cuts: quantiles by a parallel selection ----------------------------------------- */
+
+/* A double as an unsigned integer of the same order (IEEE 754: a positive number with its
+ * sign bit set, a negative one with every bit flipped), so that the selection below bisects
+ * integers: x < y exactly when key(x) < key(y). */
+static uint64_t order_key(double x)
 {
-    qsort(s, n, sizeof *s, cmp_double);
-    d->cut[0] = -INFINITY;
-    d->cut[d->size] = INFINITY;
-    for (int r = 1; r < d->size; r++) {
-        const size_t k = (size_t)((double)r * (double)n / d->size);
-        d->cut[r] = n ? s[k < n ? k : n - 1] : 0.0;
-        if (d->cut[r] < d->cut[r - 1]) d->cut[r] = d->cut[r - 1];
+    uint64_t b;
+    memcpy(&b, &x, sizeof b);
+    return b >> 63 ? ~b : b | (1ULL << 63);
+}
+
+static double key_value(uint64_t k)
+{
+    const uint64_t b = k >> 63 ? k & ~(1ULL << 63) : ~k;
+    double x;
+    memcpy(&x, &b, sizeof x);
+    return x;
+}
+
+static int cmp_key(const void *a, const void *b)
+{
+    const uint64_t x = *(const uint64_t *)a, y = *(const uint64_t *)b;
+    return (x > y) - (x < y);
+}
+
+/* How many of the n sorted keys are <= v. */
+static uint64_t count_upto(const uint64_t *keys, size_t n, uint64_t v)
+{
+    size_t a = 0, b = n; /* the first key > v */
+    while (a < b) {
+        const size_t m = a + (b - a) / 2;
+        if (keys[m] <= v)
+            a = m + 1;
+        else
+            b = m;
+    }
+    return a;
+}
+
+/* The cuts of lub_par_quantiles with the caller's buffers: keys (n), sel (3 (parts + 1)).
+ * Every cut is the exact order statistic of all ranks' coordinates, found by bisecting the
+ * keys' 64 bits: at each of at most 64 rounds every rank counts its keys up to the middle of
+ * each cut's interval (a binary search in its sorted keys) and one MPI_Allreduce sums the
+ * counts of all cuts, so the memory is this rank's coordinates and O(parts), never all N.
+ * The result is the whole sort's (the all-gather this replaced): cut r is the
+ * floor(r N / parts)-th smallest coordinate (from 0), equal coordinates (a lattice's column)
+ * together on the rank of the first. */
+static void quantiles(const double *x, size_t n, int parts, double *cut, uint64_t *keys,
+                      uint64_t *sel)
+{
+    for (size_t i = 0; i < n; i++) keys[i] = order_key(x[i]);
+    qsort(keys, n, sizeof *keys, cmp_key);
+    const uint64_t total = (uint64_t)lub_par_sum_long((long)n);
+    cut[0] = -INFINITY;
+    cut[parts] = INFINITY;
+    if (total == 0) {
+        for (int r = 1; r < parts; r++) cut[r] = 0.0;
+        return;
+    }
+    uint64_t range[2] = {n ? keys[0] : UINT64_MAX, n ? ~keys[n - 1] : UINT64_MAX};
+    MPI_Allreduce(MPI_IN_PLACE, range, 2, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD);
+    uint64_t *lo = sel, *hi = sel + parts + 1, *cnt = sel + 2 * (parts + 1);
+    for (int r = 1; r < parts; r++) lo[r] = range[0], hi[r] = ~range[1];
+    for (;;) {
+        int busy = 0;
+        for (int r = 1; r < parts; r++) {
+            cnt[r] = 0;
+            if (lo[r] < hi[r]) cnt[r] = count_upto(keys, n, lo[r] + (hi[r] - lo[r]) / 2), busy = 1;
+        }
+        if (!busy) break; /* every rank sees the same intervals: all stop together */
+        MPI_Allreduce(MPI_IN_PLACE, cnt + 1, parts - 1, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
+        for (int r = 1; r < parts; r++) {
+            if (lo[r] >= hi[r]) continue;
+            const uint64_t want = (uint64_t)((double)r * (double)total / parts);
+            const uint64_t mid = lo[r] + (hi[r] - lo[r]) / 2;
+            if (cnt[r] > (want < total ? want : total - 1))
+                hi[r] = mid;
+            else
+                lo[r] = mid + 1;
+        }
+    }
+    for (int r = 1; r < parts; r++) {
+        cut[r] = key_value(lo[r]);
+        if (cut[r] < cut[r - 1]) cut[r] = cut[r - 1];
     }
 }
 
-size_t lub_par_decompose(lub_par *d, lub_particles *P)
+void lub_par_quantiles(const double *x, size_t n, int parts, double *cut)
 {
-    const size_t n = P->n;
-    const int a = d->axis;
-    free(d->coord);
-    d->coord = lub_malloc((n ? n : 1) * sizeof *d->coord);
-    for (size_t i = 0; i < n; i++) d->coord[i] = P->x[a][i];
-    cut_at_quantiles(d, d->coord, n);
-    size_t k = 0, most = 0;
-    size_t *count = lub_calloc((size_t)d->size, sizeof *count);
-    for (size_t i = 0; i < n; i++) {
-        const int o = lub_par_owner(d, P->x[a][i]);
-        count[o]++;
-        if (o == d->rank) move_particle(P, k++, i);
-    }
-    for (int r = 0; r < d->size; r++)
-        if (count[r] > most) most = count[r];
-    free(count);
-    P->n = k;
-    d->nown = k;
-    d->nhalo = 0;
-    d->ntotal = n;
-    return most;
+    uint64_t *keys = lub_malloc((n ? n : 1) * sizeof *keys);
+    uint64_t *sel = lub_malloc(3 * ((size_t)parts + 1) * sizeof *sel);
+    quantiles(x, n, parts, cut, keys, sel);
+    free(keys);
+    free(sel);
 }
 
+static void *grow_buf(unsigned char **b, size_t *cap, size_t bytes);
 static long displs(const int *count, int *displ, int size);
+
+/* The cuts of d at the quantiles of the coordinates x (n of this rank's), with d's buffers. */
+static void cut_at_quantiles(lub_par *d, const double *x, size_t n)
+{
+    uint64_t *keys = grow_buf(&d->keys, &d->keys_cap, (n ? n : 1) * sizeof(uint64_t));
+    quantiles(x, n, d->size, d->cut, keys, d->sel);
+}
 
 int lub_par_rebalance(lub_par *d, const lub_particles *P, double imbalance)
 {
@@ -449,14 +545,10 @@ int lub_par_rebalance(lub_par *d, const lub_particles *P, double imbalance)
     const double most = lub_par_max((double)d->nown), mean = (double)d->ntotal / d->size;
     int recut = 0;
     if (most > (1 + imbalance) * mean) {
-        int cnt = (int)d->nown;
-        MPI_Allgather(&cnt, 1, MPI_INT, d->mrcount, 1, MPI_INT, MPI_COMM_WORLD);
-        const long total = displs(d->mrcount, d->mrdispl, d->size);
+        const long total = lub_par_sum_long((long)d->nown);
         if ((size_t)total != d->ntotal)
             lub_bug("re-balancing: %ld particles on the ranks, %zu at the start", total, d->ntotal);
-        MPI_Allgatherv(P->x[d->axis], cnt, MPI_DOUBLE, d->coord, d->mrcount, d->mrdispl, MPI_DOUBLE,
-                       MPI_COMM_WORLD);
-        cut_at_quantiles(d, d->coord, d->ntotal);
+        cut_at_quantiles(d, P->x[d->axis], d->nown);
         d->nbalanced++;
         recut = 1;
     }
@@ -516,12 +608,17 @@ static long displs(const int *count, int *displ, int size)
     return t;
 }
 
-static void need_capacity(const lub_particles *P, size_t n, const char *what)
+/* Room for n particles in P: beyond its capacity the owner's grow (lubFoam: the particles
+ * and the solver's arrays re-sized, once, between steps), else a run failure. */
+static void need_capacity(lub_par *d, lub_particles *P, size_t n, const char *what)
 {
+    if (n <= P->cap) return;
+    if (d->grow) {
+        d->grow(d->grow_ctx, n, what);
+        d->nresized++;
+    }
     if (n > P->cap)
-        lub_fatal_run("%s: %zu particles on this rank exceed its capacity %zu (a slab holds "
-                      "more than the whole case had at the start?)",
-                      what, n, P->cap);
+        lub_fatal_run("%s: %zu particles on this rank exceed its capacity %zu", what, n, P->cap);
 }
 
 /* An MPI datatype of `size` bytes, contiguous (counts in particles, records of any size). */
@@ -542,7 +639,7 @@ static long exchange(lub_par *d, lub_particles *P, const double *sb, const int *
     const size_t nr = record_doubles(P);
     MPI_Alltoall(scount, 1, MPI_INT, rcount, 1, MPI_INT, MPI_COMM_WORLD);
     const long nin = displs(rcount, rdispl, d->size);
-    need_capacity(P, at + (size_t)nin, what);
+    need_capacity(d, P, at + (size_t)nin, what);
     double *rb = grow_buf(&d->rbuf, &d->rbuf_cap, (nin ? (size_t)nin : 1) * nr * sizeof(double));
     MPI_Datatype t = record_type(nr * sizeof(double));
     MPI_Alltoallv(sb, scount, sdispl, t, rb, rcount, rdispl, t, MPI_COMM_WORLD);
@@ -607,6 +704,25 @@ static double slab_distance(const lub_par *d, int r, double x)
     return best;
 }
 
+/* Which owned particles (P's first nown) each other rank's halo needs: d->scount, sdispl;
+ * returns their number (a particle sent to several ranks counted for each). */
+static long halo_counts(lub_par *d, const lub_particles *P)
+{
+    const int a = d->axis, size = d->size;
+    memset(d->scount, 0, (size_t)size * sizeof *d->scount);
+    for (size_t i = 0; i < d->nown; i++)
+        for (int r = 0; r < size; r++)
+            if (r != d->rank && slab_distance(d, r, P->x[a][i]) < d->width) d->scount[r]++;
+    return displs(d->scount, d->sdispl, size);
+}
+
+size_t lub_par_halo_count(lub_par *d, const lub_particles *P)
+{
+    halo_counts(d, P);
+    MPI_Alltoall(d->scount, 1, MPI_INT, d->rcount, 1, MPI_INT, MPI_COMM_WORLD);
+    return (size_t)displs(d->rcount, d->rdispl, d->size);
+}
+
 void lub_par_halo(lub_par *d, lub_particles *P)
 {
     const double t0 = lub_wtime();
@@ -614,11 +730,7 @@ void lub_par_halo(lub_par *d, lub_particles *P)
     const size_t n = d->nown, nr = record_doubles(P);
     P->n = n;
     /* which owned particles each other rank needs: two passes (count, then list by rank) */
-    memset(d->scount, 0, (size_t)size * sizeof *d->scount);
-    for (size_t i = 0; i < n; i++)
-        for (int r = 0; r < size; r++)
-            if (r != d->rank && slab_distance(d, r, P->x[a][i]) < d->width) d->scount[r]++;
-    const long nsend = displs(d->scount, d->sdispl, size);
+    const long nsend = halo_counts(d, P);
     if ((size_t)nsend > d->sidx_cap) {
         free(d->sidx);
         d->sidx_cap = (size_t)nsend + (size_t)nsend / 2 + 16;
@@ -777,48 +889,169 @@ size_t lub_par_rows(lub_par *d, const lub_particles *P, lub_particles *R, uint64
     return first;
 }
 
-void lub_par_assemble(const lub_particles *S, const uint64_t *place, size_t n, lub_particles *P,
-                      const char *path)
+/* ---- the start on the slabs ----------------------------------------------------------- */
+
+/* Every place of 0 .. total - 1 once over the ranks' slices (as the whole-file reader
+ * checks): each place is sent to the rank holding that range of places, which marks them;
+ * the first place out of range or twice, or -1 (collective). */
+static long long duplicate_place(lub_par *d, const uint64_t *place, size_t n)
 {
-    const size_t nr = record_doubles(S) + 1; /* + the place */
-    int cnt = (int)S->n, *count = lub_malloc((size_t)size_ * sizeof *count);
-    int *displ = lub_malloc((size_t)size_ * sizeof *displ);
-    MPI_Allgather(&cnt, 1, MPI_INT, count, 1, MPI_INT, MPI_COMM_WORLD);
-    const long total = displs(count, displ, size_);
-    if ((size_t)total != n) lub_bug("assemble: %ld rows read of %zu", total, n);
-    double *sb = lub_malloc((S->n ? S->n : 1) * nr * sizeof(double));
-    double *rb = lub_malloc((n ? n : 1) * nr * sizeof(double));
-    for (size_t i = 0; i < S->n; i++) {
-        pack(S, i, sb + i * nr);
-        memcpy(sb + i * nr + nr - 1, &place[i], sizeof place[i]);
+    const int size = d->size;
+    const size_t total = d->ntotal;
+    long long bad = -1;
+    memset(d->mcount, 0, (size_t)size * sizeof *d->mcount);
+    for (size_t i = 0; i < n && bad < 0; i++)
+        if (place[i] >= total) bad = (long long)place[i];
+    for (size_t i = 0; i < n; i++)
+        if (place[i] < total) d->mcount[row_owner(d, place[i])]++;
+    displs(d->mcount, d->mdispl, size);
+    uint64_t *sb = lub_malloc((n ? n : 1) * sizeof *sb);
+    int *fill = d->scount;
+    memset(fill, 0, (size_t)size * sizeof *fill);
+    for (size_t i = 0; i < n; i++)
+        if (place[i] < total) {
+            const int o = row_owner(d, place[i]);
+            sb[d->mdispl[o] + fill[o]++] = place[i];
+        }
+    MPI_Alltoall(d->mcount, 1, MPI_INT, d->mrcount, 1, MPI_INT, MPI_COMM_WORLD);
+    const long nin = displs(d->mrcount, d->mrdispl, size);
+    uint64_t *rb = lub_malloc((nin ? (size_t)nin : 1) * sizeof *rb);
+    MPI_Alltoallv(sb, d->mcount, d->mdispl, MPI_UINT64_T, rb, d->mrcount, d->mrdispl, MPI_UINT64_T,
+                  MPI_COMM_WORLD);
+    const size_t first = lub_par_row_first(d, d->rank);
+    const size_t count = lub_par_row_first(d, d->rank + 1) - first;
+    unsigned char *seen = lub_calloc(count ? count : 1, 1);
+    for (long q = 0; q < nin && bad < 0; q++) {
+        if (seen[rb[q] - first]) bad = (long long)rb[q];
+        seen[rb[q] - first] = 1;
     }
+    free(seen), free(rb), free(sb);
+    long long most = bad;
+    MPI_Allreduce(&bad, &most, 1, MPI_LONG_LONG, MPI_MAX, MPI_COMM_WORLD);
+    return most;
+}
+
+typedef struct {
+    uint64_t place;
+    size_t at;
+} placed;
+
+static int cmp_placed(const void *a, const void *b)
+{
+    const placed *x = a, *y = b;
+    if (x->place != y->place) return (x->place > y->place) - (x->place < y->place);
+    return (x->at > y->at) - (x->at < y->at);
+}
+
+size_t lub_par_distribute(lub_par *d, const lub_particles *S, const uint64_t *place,
+                          lub_particles *P, const char *path)
+{
+    const double t0 = lub_wtime();
+    const int a = d->axis, size = d->size;
+    const size_t nr = record_doubles(S) + 1, n = S->n; /* + the place */
+    d->ntotal = (size_t)lub_par_sum_long((long)n);
+    const long long bad = duplicate_place(d, place, n);
+    if (bad >= 0)
+        lub_fatal("%s: /solver/order holds %llu twice or beyond the %zu particles: not a place "
+                  "of 0 .. %zu, each once",
+                  path, bad, d->ntotal, d->ntotal ? d->ntotal - 1 : 0);
+    cut_at_quantiles(d, S->x[a], n);
+    /* every particle of the slice to its slab's owner, with its place */
+    memset(d->mcount, 0, (size_t)size * sizeof *d->mcount);
+    for (size_t i = 0; i < n; i++) d->mcount[lub_par_owner(d, S->x[a][i])]++;
+    displs(d->mcount, d->mdispl, size);
+    /* (the buffers are the start's own, freed after it: the exchanges' buffers of the run,
+     * kept from step to step, stay the size of a halo) */
+    double *sb = lub_malloc((n ? n : 1) * nr * sizeof(double));
+    int *fill = d->scount;
+    memset(fill, 0, (size_t)size * sizeof *fill);
+    for (size_t i = 0; i < n; i++) {
+        const int o = lub_par_owner(d, S->x[a][i]);
+        double *rec = sb + (size_t)(d->mdispl[o] + fill[o]++) * nr;
+        pack(S, i, rec);
+        memcpy(&rec[nr - 1], &place[i], sizeof place[i]);
+    }
+    MPI_Alltoall(d->mcount, 1, MPI_INT, d->mrcount, 1, MPI_INT, MPI_COMM_WORLD);
+    const long nin = displs(d->mrcount, d->mrdispl, size);
+    double *rb = lub_malloc((nin ? (size_t)nin : 1) * nr * sizeof(double));
     MPI_Datatype t = record_type(nr * sizeof(double));
-    MPI_Allgatherv(sb, cnt, t, rb, count, displ, t, MPI_COMM_WORLD);
+    MPI_Alltoallv(sb, d->mcount, d->mdispl, t, rb, d->mrcount, d->mrdispl, t, MPI_COMM_WORLD);
     MPI_Type_free(&t);
     free(sb);
-    lub_particles_init(P, S->dim, n ? n : 1);
-    P->time = S->time;
-    P->step = S->step;
-    P->nlevels = S->nlevels;
-    memcpy(P->levels, S->levels, sizeof P->levels);
-    P->npatches = S->npatches;
-    memcpy(P->patch_names, S->patch_names, sizeof P->patch_names);
-    for (int e = 0; e < S->nextra; e++) lub_particles_extra(P, S->extra[e].name);
-    P->n = n;
-    unsigned char *seen = lub_calloc(n ? n : 1, 1);
-    for (size_t q = 0; q < n; q++) {
-        const double *rec = rb + q * nr;
-        uint64_t at;
-        memcpy(&at, &rec[nr - 1], sizeof at);
-        if (at >= n || seen[at]) {
-            free(seen), free(rb), free(count), free(displ);
-            lub_fatal("%s: /solver/order[%zu] = %llu: not a place of 0 .. %zu, each once", path, q,
-                      (unsigned long long)at, n - 1);
-        }
-        seen[at] = 1;
-        unpack(P, (size_t)at, rec);
+    /* the slab's particles in the solver's order (their places), as a serial run holds them */
+    placed *order = lub_malloc((nin ? (size_t)nin : 1) * sizeof *order);
+    for (long q = 0; q < nin; q++) {
+        memcpy(&order[q].place, rb + (size_t)q * nr + nr - 1, sizeof order[q].place);
+        order[q].at = (size_t)q;
     }
-    free(seen), free(rb), free(count), free(displ);
+    qsort(order, (size_t)nin, sizeof *order, cmp_placed);
+    lub_particles_init(P, S->dim, nin ? (size_t)nin : 1);
+    copy_header(P, S, "distribute");
+    for (long q = 0; q < nin; q++) unpack(P, (size_t)q, rb + order[q].at * nr);
+    free(order);
+    free(rb);
+    P->n = (size_t)nin;
+    d->nown = (size_t)nin;
+    d->nhalo = 0;
+    d->seconds += lub_wtime() - t0;
+    return (size_t)lub_par_max((double)nin);
+}
+
+void lub_par_collect(lub_par *d, const lub_particles *P, double width, const uint8_t *want,
+                     lub_particles *Q)
+{
+    const int a = d->axis, size = d->size;
+    const size_t nr = record_doubles(P);
+    const double w0 = d->width;
+    d->width = width; /* slab_distance against the given width */
+    memset(d->mcount, 0, (size_t)size * sizeof *d->mcount);
+    for (size_t i = 0; i < d->nown; i++)
+        for (int r = 0; r < size && want[i]; r++)
+            if (r != d->rank && slab_distance(d, r, P->x[a][i]) < width) d->mcount[r]++;
+    const long nsend = displs(d->mcount, d->mdispl, size);
+    double *sb = lub_malloc((nsend ? (size_t)nsend : 1) * nr * sizeof(double));
+    int *fill = d->scount;
+    memset(fill, 0, (size_t)size * sizeof *fill);
+    for (size_t i = 0; i < d->nown; i++)
+        for (int r = 0; r < size && want[i]; r++)
+            if (r != d->rank && slab_distance(d, r, P->x[a][i]) < width)
+                pack(P, i, sb + (size_t)(d->mdispl[r] + fill[r]++) * nr);
+    d->width = w0;
+    MPI_Alltoall(d->mcount, 1, MPI_INT, d->mrcount, 1, MPI_INT, MPI_COMM_WORLD);
+    const long nin = displs(d->mrcount, d->mrdispl, size);
+    double *rb = lub_malloc((nin ? (size_t)nin : 1) * nr * sizeof(double));
+    MPI_Datatype t = record_type(nr * sizeof(double));
+    MPI_Alltoallv(sb, d->mcount, d->mdispl, t, rb, d->mrcount, d->mrdispl, t, MPI_COMM_WORLD);
+    MPI_Type_free(&t);
+    lub_particles_init(Q, P->dim, nin ? (size_t)nin : 1);
+    copy_header(Q, P, "collect");
+    for (long q = 0; q < nin; q++) unpack(Q, (size_t)q, rb + (size_t)q * nr);
+    Q->n = (size_t)nin;
+    free(sb), free(rb);
+}
+
+void lub_par_raise(int status, const char *msg)
+{
+    const int who = lub_par_first(msg != NULL);
+    if (who < 0) return;
+    char text[2048];
+    snprintf(text, sizeof text, "%d %s", status, msg ? msg : "");
+    lub_par_bcast_text(text, sizeof text, who);
+    char *rest = NULL;
+    const int st = (int)strtol(text, &rest, 10);
+    const char *m = rest && *rest == ' ' ? rest + 1 : text;
+    if (st == LUB_EXIT_RUN) lub_fatal_run("%s", m);
+    lub_fatal("%s", m);
+}
+
+long lub_par_peak_memory(long kb, long *least, long *mean)
+{
+    long v[3] = {kb, -kb, kb};
+    MPI_Allreduce(MPI_IN_PLACE, v, 2, MPI_LONG, MPI_MAX, MPI_COMM_WORLD);
+    MPI_Allreduce(MPI_IN_PLACE, v + 2, 1, MPI_LONG, MPI_SUM, MPI_COMM_WORLD);
+    *least = -v[1];
+    *mean = v[2] / size_;
+    return v[0];
 }
 
 #endif

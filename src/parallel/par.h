@@ -3,15 +3,17 @@
  *
  * Decomposition: slabs along one axis (system/decomposeParDict.yaml, method slabs).  Rank r
  * owns the particles (fluid, wall and dummy) whose coordinate on the axis lies in
- * [cut[r], cut[r+1]); the cuts are set once, at the start, from the particle counts (the
- * quantiles of the coordinate: every rank holds about N / P particles).  Each rank keeps
+ * [cut[r], cut[r+1]); the cuts are set at the start, and again when re-balancing, at the
+ * quantiles of the coordinate over all ranks (every rank holds about N / P particles),
+ * found by a parallel selection that holds no rank's copy of all N.  Each rank keeps
  * its owned particles first in its lub_particles (indices 0 .. nown-1) and, during a step,
  * copies of the other ranks' particles within `width` of its slab (the halo, appended after
  * them: nown .. nown+nhalo-1), so that every neighbour sum of an owned particle is complete.
  *
  *     lub_par_start(&argc, &argv);              first thing in main (MPI_Init)
  *     lub_par_init(&d, axis, width, lo, hi, periodic_axis);
- *     lub_par_decompose(&d, P);                 every rank holds all particles: keeps its own
+ *     lub_par_distribute(&d, S, place, P);      each rank's slice of the start's file S to the
+ *                                               slabs' owners: P holds this rank's slab
  *     each step (mps/step.c):
  *         lub_par_migrate(&d, P);               owned particles that left the slab to their owner
  *         lub_par_halo(&d, P);                  the halo, all fields; P->n = nown + nhalo
@@ -52,6 +54,8 @@
  *                                    # when the fullest rank holds > (1 + imbalance) x mean
  *     writeParticles: auto           # collective (MPI-IO, every rank its rows: a build with
  *                                    # Open MPI's HDF5) | gather (to rank 0) | auto
+ *     margin: 0.2                    # a slab's room at the start beyond its particles and
+ *                                    # halo, for the migration (re-sized when it fills)
  *
  * Read from path for a dim-D case; nranks > 0: numberOfSubdomains must equal it (an error
  * at its line naming both otherwise).  Fatal (exit 1) at file:line on bad input. */
@@ -60,6 +64,7 @@ typedef struct {
     long interval;    /* balance.interval (0: never) */
     double imbalance; /* balance.imbalance */
     int write;        /* writeParticles: LUB_PAR_WRITE_* */
+    double margin;    /* margin */
 } lub_par_dict;
 enum { LUB_PAR_WRITE_AUTO, LUB_PAR_WRITE_COLLECTIVE, LUB_PAR_WRITE_GATHER };
 void lub_par_read_dict(lub_par_dict *pd, const char *path, int dim, int nranks);
@@ -74,6 +79,13 @@ void lub_par_start(int *argc, char ***argv);
 int lub_par_started(void);
 int lub_par_rank(void);
 int lub_par_size(void);
+/* Collective: when some rank has a message (msg != NULL), every rank ends with the first such
+ * rank's (status LUB_EXIT_INPUT or LUB_EXIT_RUN; rank 0 prints it during the start-up): a
+ * start-up check made on each rank's slab fails on all ranks together, its message once. */
+void lub_par_raise(int status, const char *msg);
+/* The peak resident memory over the ranks (kb: this rank's, lub_peak_memory_kb), the least
+ * and the mean (collective). */
+long lub_par_peak_memory(long kb, long *least, long *mean);
 /* The ranks' start-up (same work on the same input) is over: from now on a fatal error is
  * the failing rank's own and it prints it ("rank k: ..."), and warnings come from every
  * rank, prefixed. */
@@ -89,6 +101,8 @@ long lub_par_sum_long(long v);
  * (function objects: their bins and totals over the owned particles of every rank). */
 void lub_par_sum_doubles(double *a, size_t n);
 void lub_par_sum_longs(long *a, size_t n);
+/* Element-wise minima over the ranks, in place. */
+void lub_par_min_doubles(double *a, size_t n);
 /* The sum of v over the ranks below this one. */
 long lub_par_exscan(long v);
 /* Rank 0's text to every rank (size bytes, NUL-terminated). */
@@ -118,33 +132,62 @@ typedef struct {
     double halo_sum, owned_sum; /* the halo's and the owned counts summed over the halos built */
     long interval;              /* re-balance every interval steps (0: never; set by the caller) */
     double imbalance;           /* when the fullest rank holds > (1 + imbalance) x the mean */
-    double *coord;              /* [ntotal] every rank's coordinates on the axis (re-balancing) */
-    long nbalanced;             /* re-cuts so far */
+    unsigned char *keys;        /* the selection's sorted coordinates (this rank's) */
+    size_t keys_cap;
+    uint64_t *sel;  /* [3 (size + 1)] the selection's intervals and counts */
+    long nbalanced; /* re-cuts so far */
+    /* When a migration or a halo would exceed P's capacity: grow(grow_ctx, n, what) makes
+     * room for n particles (lubFoam: lub_mps_resize, the particles and the solver's arrays
+     * re-sized between steps); NULL: a run failure (exit 2). */
+    void (*grow)(void *ctx, size_t n, const char *what);
+    void *grow_ctx;
+    double margin; /* the room a re-size leaves beyond n (decomposeParDict margin) */
+    long nresized; /* re-sizes so far */
 } lub_par;
 
 /* Slabs of the axis (0, 1, 2) of the box [lo, hi] (periodic: the axis is periodic), halo
  * width (the neighbour search's radius re (1 + skin) and a margin). */
 void lub_par_init(lub_par *d, int axis, double width, double lo, double hi, int periodic);
 void lub_par_free(lub_par *d);
-/* The longest axis of the fluid particles' bounding box (every rank holds all particles). */
+/* The longest axis of the fluid particles' bounding box over all ranks' particles P.
+ * Collective. */
 int lub_par_longest_axis(const lub_particles *P);
-/* Every rank holds all particles (read from the same file): the cuts at the quantiles of
- * the axis coordinate, and P keeps this rank's particles (in their order).  Returns the
- * number of particles of the most loaded rank. */
-size_t lub_par_decompose(lub_par *d, lub_particles *P);
+/* The cuts at the quantiles of the coordinates x (this rank's n) over all ranks: cut[0] =
+ * -inf, cut[parts] = +inf and cut[r] the floor(r N / parts)-th smallest of the N coordinates
+ * (from 0; 0 when N = 0), exactly what sorting all of them gives, by a parallel selection
+ * (at most 64 rounds of one MPI_Allreduce of parts - 1 counts; memory: n and O(parts)).
+ * Collective. */
+void lub_par_quantiles(const double *x, size_t n, int parts, double *cut);
+/* The start on the slabs: S holds this rank's slice of the start's file (any rows; the
+ * slices of all ranks together every particle once), place[i] the solver's place of S's
+ * particle i (/solver/order).  The cuts at the quantiles of the axis coordinate over all
+ * ranks, every particle sent to its slab's owner, and P (no storage on entry; its capacity
+ * the slab's particles) holds this rank's particles in the order of their places, as
+ * lub_particles_read and a cut of the whole would give them.  Places out of range or twice
+ * are a fatal input error naming path.  Returns the number of particles of the most loaded
+ * rank.  Collective. */
+size_t lub_par_distribute(lub_par *d, const lub_particles *S, const uint64_t *place,
+                          lub_particles *P, const char *path);
+/* The number of halo particles this rank would receive now (P->n = nown; d->width set): for
+ * the capacity of the slab before the solver is built.  Collective. */
+size_t lub_par_halo_count(lub_par *d, const lub_particles *P);
+/* Q (no storage on entry) gets a copy of the other ranks' owned particles with want[i] set
+ * that lie within width of this rank's slab (the period taken into account): a start-up
+ * check of pairs across the slabs (movingWalls: the walls meeting).  Collective. */
+void lub_par_collect(lub_par *d, const lub_particles *P, double width, const uint8_t *want,
+                     lub_particles *Q);
 /* Re-balancing (P->n = nown): when the fullest rank holds more than (1 + imbalance) times
- * the mean count, new cuts at the quantiles of all ranks' coordinates (an all-gather of
- * them: O(N) per re-cut, fine every few tens of steps); lub_par_migrate then moves the
- * particles.  Returns 1 when it re-cut.  Collective. */
+ * the mean count, new cuts at the quantiles of all ranks' coordinates (lub_par_quantiles);
+ * lub_par_migrate then moves the particles.  Returns 1 when it re-cut.  Collective. */
 int lub_par_rebalance(lub_par *d, const lub_particles *P, double imbalance);
 /* The rank owning a coordinate on the axis. */
 int lub_par_owner(const lub_par *d, double x);
 /* P->n = nown on entry: owned particles whose coordinate left the slab go to their owner
- * (every field, the extras included, appended there); nown updated.  Fatal (exit 2) when a
- * rank's particles would exceed its capacity P->cap. */
+ * (every field, the extras included, appended there); nown updated.  Beyond P->cap: d->grow,
+ * else fatal (exit 2). */
 void lub_par_migrate(lub_par *d, lub_particles *P);
 /* P->n = nown on entry: the halo (every field of the other ranks' particles within width of
- * this slab) appended; P->n = nown + nhalo.  Fatal (exit 2) beyond P->cap. */
+ * this slab) appended; P->n = nown + nhalo.  Beyond P->cap: d->grow, else fatal (exit 2). */
 void lub_par_halo(lub_par *d, lub_particles *P);
 /* The halo's copy of one per-particle array a (elements of elsize bytes: 1, 2, 4 or 8), from
  * the owners' values: a[nown + k] = the owner's a[i]. */
@@ -168,13 +211,5 @@ int lub_par_ids_dense(const lub_par *d, const lub_particles *P);
  * of lub_par_gather (rank after rank, each in its own order).  Returns the first row.
  * Collective; the ids must be dense (lub_par_ids_dense). */
 size_t lub_par_rows(lub_par *d, const lub_particles *P, lub_particles *R, uint64_t *place);
-
-/* The rank-slice read of a restart: every rank's rows of a particle file of n particles (S
- * and place, from lub_particles_read_rows; the ranks' slices together every row once) into
- * P on every rank, each particle at its place: the file's particles in the solver's order,
- * what lub_particles_read gives.  P must hold no storage.  A place out of range or twice is
- * a fatal input error naming path.  Collective. */
-void lub_par_assemble(const lub_particles *S, const uint64_t *place, size_t n, lub_particles *P,
-                      const char *path);
 
 #endif

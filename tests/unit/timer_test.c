@@ -51,6 +51,33 @@ static void test_load_average(void)
     CHECK(avg == -1.0 || running >= 1);
 }
 
+/* VmHWM of /proc/self/status: parsed from a file of its format, and on the real one it
+ * grows by at least what the process touches beyond its peak (64 MB written) */
+static void test_peak_memory(void)
+{
+    char path[] = "/tmp/lub_status_XXXXXX";
+    int fd = mkstemp(path);
+    CHECK(fd >= 0);
+    FILE *f = fdopen(fd, "w");
+    fputs("Name:\tlubFoam\nVmPeak:\t  900000 kB\nVmHWM:\t  295012 kB\nVmRSS:\t  1000 kB\n", f);
+    fclose(f);
+    CHECK(lub_peak_memory_kb(path) == 295012);
+    f = fopen(path, "w");
+    fputs("Name:\tx\n", f);
+    fclose(f);
+    CHECK(lub_peak_memory_kb(path) == -1);
+    remove(path);
+    CHECK(lub_peak_memory_kb(path) == -1);
+    const long before = lub_peak_memory_kb(NULL);
+    if (before < 0) return; /* no /proc here */
+    const size_t bytes = ((size_t)before + 65536) * 1024;
+    volatile char *b = malloc(bytes);
+    CHECK(b != NULL);
+    for (size_t i = 0; i < bytes; i += 4096) b[i] = 1;
+    CHECK(lub_peak_memory_kb(NULL) >= before + 65536);
+    free((void *)b);
+}
+
 static void test_load_now(void)
 {
     /* a two-thread run ended seconds ago: the average still reads 1.5, nothing runs now */
@@ -89,6 +116,7 @@ int main(void)
 {
     RUN(test_timers);
     RUN(test_load_average);
+    RUN(test_peak_memory);
     RUN(test_oversubscribed);
     RUN(test_load_now);
     return test_summary();

@@ -216,12 +216,13 @@ static void check_limits(lubfoam_run *r, const lub_geometry *geo)
 static void print_header(const lubfoam_run *r, double average, int others_running)
 {
     const lub_mps *m = r->scene.level[0];
-    size_t cnt[3] = {0, 0, 0};
+    long cnt[3] = {0, 0, 0}; /* -parallel: of every rank's slab */
     for (size_t i = 0; i < r->P.n; i++) cnt[r->P.kind[i] < 3 ? r->P.kind[i] : 0]++;
+    if (r->parallel) lub_par_sum_longs(cnt, 3);
     lub_message("lubFoam: case %s, start time %s (step %ld), %d-D", r->cs.root, r->start_name,
                 r->step, m->dim);
-    lub_message("Particles: %zu (fluid %zu, wall %zu, dummy %zu), threads %d", r->P.n, cnt[0],
-                cnt[1], cnt[2], omp_get_max_threads());
+    lub_message("Particles: %ld (fluid %ld, wall %ld, dummy %ld), threads %d",
+                cnt[0] + cnt[1] + cnt[2], cnt[0], cnt[1], cnt[2], omp_get_max_threads());
     const double load = lub_load_now(average, others_running);
     int fit = 1;
     if (lub_threads_oversubscribed(load, omp_get_num_procs(), omp_get_max_threads(), &fit))
@@ -290,6 +291,22 @@ static void run_free(lubfoam_run *r, lubfoam_functions *fos)
     free(r->written);
 }
 
+/* -parallel: the peak resident memory of the ranks (the start-up included) and what each
+ * holds: its slab, not the case (doc/parallel.md, per-rank capacity).  Collective. */
+static void report_memory(const lubfoam_run *r)
+{
+    long least, mean;
+    const long peak = lub_par_peak_memory(lub_peak_memory_kb(NULL), &least, &mean);
+    const double cap = lub_par_max((double)r->P.cap);
+    const long resized = lub_par_sum_long(r->par.nresized);
+    lub_message("Memory: peak resident (VmHWM) per rank %.1f MB on the fullest rank, %.1f MB on "
+                "the least, mean %.1f MB; capacity at most %.0f particles per rank (%.1f%% of "
+                "the case), re-sized %ld time%s during the run",
+                peak / 1024.0, least / 1024.0, mean / 1024.0, cap,
+                r->par.ntotal ? 100 * cap / (double)r->par.ntotal : 0.0, resized,
+                resized == 1 ? "" : "s");
+}
+
 /* Cost summary on the log and in postProcessing/cost/<startTime>/cost.dat. */
 static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, double vit_sum)
 {
@@ -315,6 +332,7 @@ static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, 
         /* the halo against the owned particles, over all ranks and steps: the work on the
          * copies (their lists, PND, gradients) and the size of the exchanges */
         const double halo = lub_par_sum(r->par.halo_sum), owned = lub_par_sum(r->par.owned_sum);
+        report_memory(r);
         lub_message("  %d ranks: %.4g core-us per particle-step (wall x ranks x threads / "
                     "particle-steps), %.4g by the ranks' CPU time (%.3f s); communication "
                     "(halo, migration, gathers) %.3f s, %.1f%% of the wall time on the rank "
@@ -390,16 +408,19 @@ int main(int argc, char **argv)
             "  listing them): lubClean removes them first, startFrom: latestTime continues.\n"
             "  -parallel runs on the processes of 'mpirun -np N lubFoam -parallel' (a build\n"
             "  with MPI: make MPI=1, the default with PETSc): system/decomposeParDict.yaml\n"
-            "  gives numberOfSubdomains (= N), the slabs' axis and their re-balancing; every\n"
-            "  rank reads the dictionaries and particles, keeps its slab and a halo of its\n"
+            "  gives numberOfSubdomains (= N), the slabs' axis, their re-balancing and the\n"
+            "  margin; every rank reads the dictionaries and its rows of the start's\n"
+            "  particles, keeps its slab (sized for it, its halo and the margin: no rank\n"
+            "  holds the whole case; re-sized between steps if it fills) and a halo of its\n"
             "  neighbours' particles, the pressure (and implicit viscosity) is solved by\n"
             "  PETSc over all ranks (solver: petsc in system/solution.yaml); the time\n"
             "  folders are a serial run's: every rank writes its rows of particles.h5\n"
             "  (MPI-IO: a build with Open MPI's HDF5), or rank 0 the particles gathered to\n"
             "  it (the serial HDF5, or writeParticles: gather), and rank 0 the rest, the log\n"
             "  and the function objects' tables (totals, wallPressure, wallLoad: sums over\n"
-            "  every rank's particles).  A restart reads each rank's rows of the start's\n"
-            "  particles.h5, on any number of ranks.  Models\n"
+            "  every rank's particles); the end of the log gives each rank's peak memory.\n"
+            "  A restart reads each rank's rows of the start's particles.h5, on any number\n"
+            "  of ranks.  Models\n"
             "  other than gravity, movingWalls and collision, fluid type mph, LSMPS\n"
             "  Laplacians and the function object forces are refused (exit 1).\n"
             "  -dryRun reads and checks every dictionary and the start particles, prints the\n"
@@ -446,11 +467,15 @@ int main(int argc, char **argv)
     lub_control_read(&r.ctl, lub_case_path(&r.cs, path, "system/controlDict.yaml"));
     lub_geometry geo;
     lub_geometry_read(&geo, lub_case_path(&r.cs, path, "system/particleGenDict.yaml"));
-    lubfoam_read_start(&r);
+    /* -parallel: each rank reads its slice of the start's particles and keeps its slab; the
+     * start-up checks and figures over particles are then collective */
+    if (parallel) lubfoam_parallel_start(&r, &geo);
+    lubfoam_read_start(&r, &geo);
     lubfoam_check_particles(&r, &geo);
     /* the fluid and the models the scene lists, and the solvers they need */
     lub_mps_config cfg;
     lub_scene_read(&r.scene, &r.cs, &r.P, &geo, &cfg);
+    if (parallel) lubfoam_parallel_capacity(&r, &cfg);
     char state[LUB_PATH_MAX], what[128];
     lub_case_pathf(&r.cs, state, "%s/uniform/state.yaml", r.start_name);
     snprintf(what, sizeof what, "endTime %g of system/controlDict.yaml", r.ctl.end_time);
@@ -462,7 +487,7 @@ int main(int argc, char **argv)
     print_header(&r, load_average, others_running);
     check_limits(&r, &geo);
     lubfoam_check_levels(&r, &geo);
-    if (parallel) lubfoam_parallel_setup(&r, &geo, fos);
+    if (parallel) lubfoam_parallel_setup(&r, fos);
     lub_par_startup_done(); /* from here, a rank's error is its own */
     r.scene.geo = NULL;
     lub_geometry_free(&geo);
@@ -500,6 +525,7 @@ int main(int argc, char **argv)
                         r.ctl.end_time, h, r.start_name, t_last, k * nr);
     }
     if (dry_run) {
+        if (r.parallel) report_memory(&r);
         lub_message("lubFoam -dryRun: the dictionaries and the particles of time %s are valid; "
                     "nothing run, nothing written",
                     r.start_name);

@@ -40,6 +40,8 @@ typedef struct {
     int parallel;
     double cpu0; /* CPU seconds of the process when the time loop began (the cost) */
     lub_par par;
+    lub_par_dict pd; /* system/decomposeParDict.yaml */
+    size_t most;     /* the particles of the fullest slab at the start */
     lub_particles G;
     int collective;
     lub_particles R;
@@ -49,12 +51,30 @@ typedef struct {
 /* -parallel on the command line (MPI is started before the arguments are parsed). */
 int lubfoam_wants_parallel(int argc, char **argv);
 typedef struct lubfoam_functions lubfoam_functions;
-/* -parallel: system/decomposeParDict.yaml against mpirun's process count, the models,
- * solvers and function objects (fos) refused that are not parallel yet (exit 1, naming
- * them), then this rank's slab kept and the solver told (after the scene is built on all
- * particles). */
-void lubfoam_parallel_setup(lubfoam_run *r, const lub_geometry *geo, const lubfoam_functions *fos);
+/* -parallel, the start on the slabs (lubFoamParallel.c), in the order main calls them:
+ *   _start       system/decomposeParDict.yaml against mpirun's process count, and the models
+ *                of constant/models.yaml that are not parallel yet refused (exit 1, naming
+ *                them), before anything reads the particles;
+ *   _distribute  (lubfoam_read_start) this rank's slice of the start's file S (rows, their
+ *                solver's places) sent to the slabs' owners: r->P holds this rank's slab;
+ *   _capacity    (after lub_scene_read: the solver's configuration cfg) the formulation and
+ *                solvers refused that are not parallel, the halo's width, and r->P's capacity
+ *                for the slab, its halo and the margin, so that the solver built next is
+ *                sized for them; the scene told of the ranks;
+ *   _setup       (after the scene is built) the function objects refused that are not
+ *                parallel, the decomposition said, the particle files' way chosen. */
+void lubfoam_parallel_start(lubfoam_run *r, const lub_geometry *geo);
+void lubfoam_parallel_distribute(lubfoam_run *r, const lub_geometry *geo, const lub_particles *S,
+                                 const uint64_t *place, const char *path);
+void lubfoam_parallel_capacity(lubfoam_run *r, const lub_mps_config *cfg);
+void lubfoam_parallel_setup(lubfoam_run *r, const lubfoam_functions *fos);
 void lubfoam_parallel_free(lubfoam_run *r);
+/* A start-up check of the particles (check(r, ctx), fatal on failure): serially as it is;
+ * -parallel, on this rank's slab, its failure every rank's (rank 0 prints the message of
+ * the first failing rank, once). */
+void lubfoam_collective_check(const lubfoam_run *r,
+                              void (*check)(const lubfoam_run *r, const void *ctx),
+                              const void *ctx);
 /* Rank 0 writes the time folders (1 in a serial run); with r->collective every rank writes
  * its rows of the particle file. */
 static inline int lubfoam_writer_rank(const lubfoam_run *r)
@@ -62,8 +82,9 @@ static inline int lubfoam_writer_rank(const lubfoam_run *r)
     return !r->parallel || r->par.rank == 0;
 }
 
-/* Start time folder per controlDict (startFrom), reading particles and uniform/state.yaml. */
-void lubfoam_read_start(lubfoam_run *r);
+/* Start time folder per controlDict (startFrom), reading particles and uniform/state.yaml;
+ * -parallel: each rank its rows of the particle file, then its slab (geo: the domain). */
+void lubfoam_read_start(lubfoam_run *r, const lub_geometry *geo);
 /* Before the time loop: the writer's buffers (for r->P's capacity), the index of
  * particles.xdmf, and the leftovers of runs killed while writing removed (temporary files
  * and folders whose process is gone: lub_case_clean). */

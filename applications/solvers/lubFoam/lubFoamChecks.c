@@ -239,6 +239,31 @@ void lubfoam_check_levels(const lubfoam_run *r, const lub_geometry *geo)
     check_reynolds(L, &r->cs);
 }
 
+/* Every particle inside the domain (the periodic directions aside); -parallel: each rank its
+ * slab's (lubfoam_collective_check). */
+static void check_inside(const lubfoam_run *r, const void *ctx)
+{
+    const lub_geometry *geo = ctx;
+    const lub_particles *P = &r->P;
+    char file[LUB_PATH_MAX];
+    lub_case_pathf(&r->cs, file, "%s/particles.h5", r->start_name);
+    static const char *const kinds[] = {"fluid", "wall", "dummy"};
+    for (size_t i = 0; i < P->n; i++)
+        for (int d = 0; d < P->dim; d++) {
+            if (geo->periodic[d]) continue;
+            const double x = P->x[d][i];
+            if (x >= geo->dmin[d] && x <= geo->dmax[d]) continue;
+            char patch[LUB_NAME_MAX + 16] = "";
+            if (P->kind[i] != LUB_FLUID && P->patch[i] < P->npatches)
+                snprintf(patch, sizeof patch, " of patch '%s'", P->patch_names[P->patch[i]]);
+            lub_fatal("%s: %s particle id %llu%s lies outside the domain of "
+                      "system/particleGenDict.yaml: %c = %g outside [%g, %g] (particles of "
+                      "another case or geometry? run particleGen)",
+                      file, kinds[P->kind[i] < 3 ? P->kind[i] : 0], (unsigned long long)P->id[i],
+                      patch, "xyz"[d], x, geo -> dmin[d], geo -> dmax[d]);
+        }
+}
+
 /* The start folder's particles against system/particleGenDict.yaml, before the solver is set
  * up: particles of another case (or of an older geometry) were found only at step 1, as a
  * particle "leaving" a domain it was never in (exit 2, naming no file). */
@@ -256,19 +281,5 @@ void lubfoam_check_particles(const lubfoam_run *r, const lub_geometry *geo)
         lub_fatal("%s: the particles have l0 = %.10g m but system/particleGenDict.yaml says l0 = "
                   "%.10g m (particles of another geometry? run particleGen)",
                   file, l0p, l0);
-    static const char *const kinds[] = {"fluid", "wall", "dummy"};
-    for (size_t i = 0; i < P->n; i++)
-        for (int d = 0; d < P->dim; d++) {
-            if (geo->periodic[d]) continue;
-            const double x = P->x[d][i];
-            if (x >= geo->dmin[d] && x <= geo->dmax[d]) continue;
-            char patch[LUB_NAME_MAX + 16] = "";
-            if (P->kind[i] != LUB_FLUID && P->patch[i] < P->npatches)
-                snprintf(patch, sizeof patch, " of patch '%s'", P->patch_names[P->patch[i]]);
-            lub_fatal("%s: %s particle id %llu%s lies outside the domain of "
-                      "system/particleGenDict.yaml: %c = %g outside [%g, %g] (particles of "
-                      "another case or geometry? run particleGen)",
-                      file, kinds[P->kind[i] < 3 ? P->kind[i] : 0], (unsigned long long)P->id[i],
-                      patch, "xyz"[d], x, geo -> dmin[d], geo -> dmax[d]);
-        }
+    lubfoam_collective_check(r, check_inside, geo);
 }

@@ -70,12 +70,11 @@ static void warn_earlier_results(const lub_case *cs, const char *start)
 }
 
 /* -parallel: the rank-slice read.  Each rank reads its rows of the file (about N / size, by
- * hyperslabs: the file is read once over the ranks, not once per rank), and the slices
- * together make every rank's particles, each at its place in the solver's order: what
- * lub_particles_read gives, since the start-up still builds the scene on all particles
- * (doc/parallel.md, per-rank capacity).  An error in one rank's rows is every rank's (rank
- * 0 prints it, as the start-up's other errors). */
-static void read_start_parallel(lubfoam_run *r, const char *path)
+ * hyperslabs: the file is read once over the ranks, not once per rank), and the slices go to
+ * the slabs' owners: each rank then holds its slab, in the solver's order, and never the
+ * whole case (doc/parallel.md, per-rank capacity).  An error in one rank's rows is every
+ * rank's (rank 0 prints it, as the start-up's other errors). */
+static void read_start_parallel(lubfoam_run *r, const lub_geometry *geo, const char *path)
 {
     lub_particles_info info;
     lub_particles_read_info(path, &info);
@@ -85,27 +84,20 @@ static void read_start_parallel(lubfoam_run *r, const char *path)
         (size_t)((unsigned long long)(q + 1) * info.n / (unsigned long long)size) - first;
     uint64_t *place = lub_malloc((count ? count : 1) * sizeof *place);
     lub_particles S;
-    char msg[2048] = "";
-    int failed = 0;
     lub_catcher c;
     if (lub_error_catch(&c) == 0) {
         lub_particles_read_rows(&S, path, first, count, place);
         lub_error_uncatch();
+        lub_par_raise(LUB_EXIT_INPUT, NULL);
     } else {
-        failed = 1;
-        snprintf(msg, sizeof msg, "%s", c.message);
+        lub_par_raise(c.status, c.message);
     }
-    const int who = lub_par_first(failed);
-    if (who >= 0) {
-        lub_par_bcast_text(msg, sizeof msg, who);
-        lub_fatal("%s", msg);
-    }
-    lub_par_assemble(&S, place, info.n, &r->P, path);
+    lubfoam_parallel_distribute(r, geo, &S, place, path);
     lub_particles_free(&S);
     free(place);
 }
 
-void lubfoam_read_start(lubfoam_run *r)
+void lubfoam_read_start(lubfoam_run *r, const lub_geometry *geo)
 {
     const lub_control *c = &r->ctl;
     char name[64], path[LUB_PATH_MAX];
@@ -132,8 +124,8 @@ void lubfoam_read_start(lubfoam_run *r)
     snprintf(r->start_name, sizeof r->start_name, "%s", name);
     if (c->start_from == LUB_START_STARTTIME) warn_earlier_results(&r->cs, name);
     lub_case_pathf(&r->cs, path, "%s/particles.h5", name);
-    if (lub_par_started())
-        read_start_parallel(r, path);
+    if (r->parallel)
+        read_start_parallel(r, geo, path);
     else
         lub_particles_read(&r->P, path);
     r->t = r->P.time;

@@ -463,82 +463,167 @@ static double min_dist(const double (*D)[3], size_t n, const double r[3], size_t
     return sqrt(best);
 }
 
+/* The samples t (*nt of them, allocated) of the relative path of patch a against patch b
+ * over [ts, te]: 2000, then fine enough that it moves by l0/20 at most between samples, with
+ * the motions' turning points; lo, hi: the path's box.  0 (nothing allocated) when the two
+ * move together, or only along the periodic directions. */
+static int pair_path(const moving_walls *mw, int a, int b, double ts, double te, const int *per,
+                     double l0, double **tp, long *ntp, double lo[3], double hi[3])
+{
+    int n0 = 2000;
+    double len = 0, r[3], rp[3];
+    relative(mw, a, b, ts, ts, per, rp);
+    for (int k = 1; k <= n0; k++) {
+        relative(mw, a, b, ts, ts + (te - ts) * k / n0, per, r);
+        len += sqrt((r[0] - rp[0]) * (r[0] - rp[0]) + (r[1] - rp[1]) * (r[1] - rp[1]) +
+                    (r[2] - rp[2]) * (r[2] - rp[2]));
+        memcpy(rp, r, sizeof r);
+    }
+    if (len == 0.0) return 0; /* they move together, or only along periodic x */
+    long n = (long)ceil(len / (0.05 * l0));
+    n = n < n0 ? n0 : n > 200000 ? 200000 : n;
+    double *t = lub_malloc((size_t)(n + 1 + 2 * 4096) * sizeof *t);
+    long nt = 0;
+    for (long k = 0; k <= n; k++) t[nt++] = ts + (te - ts) * (double)k / (double)n;
+    nt += lub_wall_motion_breaks(&mw->motion[a], ts, te, t + nt, 4096);
+    nt += lub_wall_motion_breaks(&mw->motion[b], ts, te, t + nt, 4096);
+    qsort(t, (size_t)nt, sizeof *t, cmp_double);
+    for (int d = 0; d < 3; d++) lo[d] = INFINITY, hi[d] = -INFINITY;
+    for (long k = 0; k < nt; k++) {
+        relative(mw, a, b, ts, t[k], per, r);
+        for (int d = 0; d < 3; d++) lo[d] = fmin(lo[d], r[d]), hi[d] = fmax(hi[d], r[d]);
+    }
+    *tp = t;
+    *ntp = nt;
+    return 1;
+}
+
+/* The pairs check_meeting looks at: a moves, and b either rests or comes later (each pair
+ * once), both with wall particles (counts: over all ranks). */
+static int pair_checked(const moving_walls *mw, const long *count, int a, int b)
+{
+    if (a == b || count[a] == 0 || count[b] == 0) return 0;
+    const int ma = mw->node[a] != NULL, mb = mw->node[b] != NULL;
+    return ma && !(mb && b < a);
+}
+
 /* The first time in (ts, te] at which a wall particle of a moving patch comes within l0 of
  * one of another patch (moving otherwise): the walls meet, no fluid particle fits between
  * them (wall particles l0 apart).  Pairs already closer than 2 l0 at ts (patches meeting at a
  * corner) count when they come within half their distance at ts.  Sets mw->t_meet and
- * mw->meet_what. */
+ * mw->meet_what.
+ *
+ * On several ranks (f->par) each rank holds its slab's particles: it takes the pairs of its
+ * own wall particles of a with the wall particles of b of every rank within reach (its own,
+ * and the other ranks' within the paths' extent along the slabs' axis and 2 l0 of its slab:
+ * lub_par_collect), the smallest distance at ts of each pair of patches over all ranks, and
+ * the earliest meeting of all ranks with its rank's message: the serial check's pairs, each
+ * on the rank of its a particle. */
 static void check_meeting(moving_walls *mw, const lub_mps *f, double ts, double te)
 {
     const lub_particles *P = f->P;
+    lub_par *par = f->par;
     const double l0 = f->l0;
-    const int dim = P->dim;
+    const int dim = P->dim, np = mw->npatches;
     int per[3] = {0, 0, 0};
     double Lp[3] = {0, 0, 0};
     for (int d = 0; d < dim; d++)
         if (f->periodic[d]) per[d] = 1, Lp[d] = f->hi[d] - f->lo[d];
-    /* the wall particles of each patch */
-    size_t *idx = lub_malloc((P->n + 1) * sizeof *idx), start[LUB_MAX_PATCHES + 1];
-    size_t nw = 0;
-    for (int p = 0; p < mw->npatches; p++) {
-        start[p] = nw;
-        for (size_t i = 0; i < P->n; i++)
-            if (P->kind[i] == LUB_WALL && P->patch[i] == p) idx[nw++] = i;
-    }
-    start[mw->npatches] = nw;
-    for (int a = 0; a < mw->npatches; a++) {
-        for (int b = 0; b < mw->npatches; b++) {
-            if (a == b || start[a] == start[a + 1] || start[b] == start[b + 1]) continue;
-            /* each pair once: a moves, and b either rests or comes later */
-            int ma = mw->node[a] != NULL, mb = mw->node[b] != NULL;
-            if (!ma || (mb && b < a)) continue;
-            /* samples of the relative path: 2000, then fine enough that it moves by l0/20
-             * at most between samples, with the motions' turning points */
-            int n0 = 2000;
-            double len = 0, r[3], rp[3];
-            relative(mw, a, b, ts, ts, per, rp);
-            for (int k = 1; k <= n0; k++) {
-                relative(mw, a, b, ts, ts + (te - ts) * k / n0, per, r);
-                len += sqrt((r[0] - rp[0]) * (r[0] - rp[0]) + (r[1] - rp[1]) * (r[1] - rp[1]) +
-                            (r[2] - rp[2]) * (r[2] - rp[2]));
-                memcpy(rp, r, sizeof r);
-            }
-            if (len == 0.0) continue; /* they move together, or only along periodic x */
-            long n = (long)ceil(len / (0.05 * l0));
-            n = n < n0 ? n0 : n > 200000 ? 200000 : n;
-            double *t = lub_malloc((size_t)(n + 1 + 2 * 4096) * sizeof *t);
+    long count[LUB_MAX_PATCHES] = {0}; /* wall particles per patch, all ranks' */
+    for (size_t i = 0; i < P->n; i++)
+        if (P->kind[i] == LUB_WALL && P->patch[i] < np) count[P->patch[i]]++;
+    if (par) lub_par_sum_longs(count, (size_t)np);
+    /* the paths of the pairs checked (the same on every rank: the motions alone) */
+    double(*plo)[3] = lub_calloc((size_t)(np * np) + 1, sizeof *plo);
+    double(*phi)[3] = lub_calloc((size_t)(np * np) + 1, sizeof *phi);
+    double reach = 0;
+    int *moves = lub_calloc((size_t)(np * np) + 1, sizeof *moves);
+    for (int a = 0; a < np; a++)
+        for (int b = 0; b < np; b++) {
+            double *t = NULL;
             long nt = 0;
-            for (long k = 0; k <= n; k++) t[nt++] = ts + (te - ts) * (double)k / (double)n;
-            nt += lub_wall_motion_breaks(&mw->motion[a], ts, te, t + nt, 4096);
-            nt += lub_wall_motion_breaks(&mw->motion[b], ts, te, t + nt, 4096);
-            qsort(t, (size_t)nt, sizeof *t, cmp_double);
-            double lo[3] = {INFINITY, INFINITY, INFINITY},
-                   hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-            for (long k = 0; k < nt; k++) {
-                relative(mw, a, b, ts, t[k], per, r);
-                for (int d = 0; d < 3; d++) lo[d] = fmin(lo[d], r[d]), hi[d] = fmax(hi[d], r[d]);
-            }
-            /* the pair differences D = x_a - x_b (nearest image), their smallest length at
-             * ts, and those that come within 2 l0 of a point of the path's box */
-            size_t na = start[a + 1] - start[a], nb = start[b + 1] - start[b], nc = 0, cap = 1024;
-            double(*D)[3] = lub_malloc(cap * sizeof *D), dmin0 = INFINITY;
-            for (size_t i = start[a]; i < start[a + 1]; i++)
+            if (!pair_checked(mw, count, a, b)) continue;
+            moves[a * np + b] =
+                pair_path(mw, a, b, ts, te, per, l0, &t, &nt, plo[a * np + b], phi[a * np + b]);
+            free(t);
+            if (par && moves[a * np + b])
+                reach = fmax(reach, fmax(fabs(plo[a * np + b][par->axis]),
+                                         fabs(phi[a * np + b][par->axis])));
+        }
+    /* the wall particles of each patch: this rank's (own), then on several ranks the other
+     * ranks' within reach of its slab */
+    lub_particles Q = {0};
+    if (par) {
+        uint8_t *want = lub_calloc(P->n + 1, 1);
+        for (size_t i = 0; i < P->n; i++) want[i] = P->kind[i] == LUB_WALL;
+        lub_par_collect(par, P, reach + 2.0 * l0 * (1 + 1e-9), want, &Q);
+        free(want);
+    }
+    const size_t nall = P->n + Q.n;
+    double(*wx)[3] = lub_malloc((nall + 1) * sizeof *wx);
+    uint8_t *own = lub_malloc(nall + 1);
+    size_t start[LUB_MAX_PATCHES + 1], nw = 0;
+    for (int p = 0; p < np; p++) {
+        start[p] = nw;
+        for (int q = 0; q < 2; q++) {
+            const lub_particles *W = q ? &Q : P;
+            for (size_t i = 0; i < W->n; i++)
+                if (W->kind[i] == LUB_WALL && W->patch[i] == p) {
+                    for (int d = 0; d < 3; d++) wx[nw][d] = d < dim ? W->x[d][i] : 0.0;
+                    own[nw++] = q == 0;
+                }
+        }
+    }
+    start[np] = nw;
+    if (par) lub_particles_free(&Q);
+    /* the smallest distance of each pair of patches at ts, over all ranks */
+    double *dmin = lub_malloc(((size_t)(np * np) + 1) * sizeof *dmin);
+    for (int k = 0; k < np * np; k++) dmin[k] = INFINITY;
+    for (int a = 0; a < np; a++)
+        for (int b = 0; b < np; b++) {
+            if (!moves[a * np + b]) continue;
+            double q2 = INFINITY;
+            for (size_t i = start[a]; i < start[a + 1]; i++) {
+                if (!own[i]) continue;
                 for (size_t j = start[b]; j < start[b + 1]; j++) {
-                    double e[3] = {0, 0, 0}, q = 0, qb = 0;
+                    double q = 0;
                     for (int d = 0; d < dim; d++) {
-                        e[d] = P->x[d][idx[i]] - P->x[d][idx[j]];
+                        double e = wx[i][d] - wx[j][d];
+                        if (per[d]) e -= Lp[d] * nearbyint(e / Lp[d]);
+                        q += e * e;
+                    }
+                    q2 = fmin(q2, q);
+                }
+            }
+            dmin[a * np + b] = sqrt(q2);
+        }
+    if (par) lub_par_min_doubles(dmin, (size_t)(np * np));
+    for (int a = 0; a < np; a++) {
+        for (int b = 0; b < np; b++) {
+            if (!moves[a * np + b]) continue;
+            double *t = NULL, lo[3], hi[3], r[3];
+            long nt = 0;
+            pair_path(mw, a, b, ts, te, per, l0, &t, &nt, lo, hi);
+            /* the pair differences D = x_a - x_b (nearest image) that come within 2 l0 of a
+             * point of the path's box */
+            size_t nc = 0, cap = 1024;
+            double(*D)[3] = lub_malloc(cap * sizeof *D);
+            for (size_t i = start[a]; i < start[a + 1]; i++) {
+                if (!own[i]) continue;
+                for (size_t j = start[b]; j < start[b + 1]; j++) {
+                    double e[3] = {0, 0, 0}, qb = 0;
+                    for (int d = 0; d < dim; d++) {
+                        e[d] = wx[i][d] - wx[j][d];
                         if (per[d]) e[d] -= Lp[d] * nearbyint(e[d] / Lp[d]);
-                        q += e[d] * e[d];
                         double c = e[d] + fmin(fmax(-e[d], lo[d]), hi[d]);
                         qb += c * c;
                     }
-                    dmin0 = fmin(dmin0, q);
                     if (qb >= 4.0 * l0 * l0) continue;
                     if (nc == cap) D = lub_realloc(D, (cap *= 2) * sizeof *D);
                     memcpy(D[nc++], e, sizeof e);
                 }
-            (void)na, (void)nb;
-            dmin0 = sqrt(dmin0);
+            }
+            const double dmin0 = dmin[a * np + b];
             const double thr = dmin0 < 2.0 * l0 ? 0.5 * dmin0 : l0;
             size_t which = 0;
             for (long k = 1; k < nt && nc > 0; k++) {
@@ -569,7 +654,13 @@ static void check_meeting(moving_walls *mw, const lub_mps *f, double ts, double 
             free(t);
         }
     }
-    free(idx);
+    free(dmin), free(wx), free(own), free(moves), free(plo), free(phi);
+    if (par) { /* the earliest of all ranks, with its rank's message */
+        const double first = -lub_par_max(-mw->t_meet);
+        const int who = lub_par_first(mw->t_meet == first && first < INFINITY);
+        if (who >= 0) lub_par_bcast_text(mw->meet_what, sizeof mw->meet_what, who);
+        mw->t_meet = first;
+    }
 }
 
 static void moving_walls_init(lub_model *m, lub_scene *s)

@@ -1,0 +1,77 @@
+/* parallel/par: the slabs' cuts by a parallel selection (lub_par_quantiles) against the
+ * order statistics of the whole sorted set, which the all-gather it replaced computed: on one
+ * process (MPI's singleton start, no mpirun) the selection runs its bisection and reductions
+ * as on many ranks, with every coordinate here.  The cuts over several ranks, and the start
+ * on the slabs, are tested under mpirun by tests/cases/parallel.  In a build without MPI it
+ * prints SKIP. */
+#include <math.h>
+#include <stdlib.h>
+
+#include "parallel/par.h"
+#include "test.h"
+
+static int cmp(const void *a, const void *b)
+{
+    const double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* The reference: cut r = the floor(r n / parts)-th smallest of the sorted coordinates. */
+static void sorted_cuts(const double *x, size_t n, int parts, double *cut)
+{
+    double *s = malloc((n ? n : 1) * sizeof *s);
+    for (size_t i = 0; i < n; i++) s[i] = x[i];
+    qsort(s, n, sizeof *s, cmp);
+    cut[0] = -INFINITY;
+    cut[parts] = INFINITY;
+    for (int r = 1; r < parts; r++) {
+        const size_t k = (size_t)((double)r * (double)n / parts);
+        cut[r] = n ? s[k < n ? k : n - 1] : 0.0;
+    }
+    free(s);
+}
+
+static int same_cuts(const double *x, size_t n, int parts)
+{
+    double a[65], b[65];
+    lub_par_quantiles(x, n, parts, a);
+    sorted_cuts(x, n, parts, b);
+    int ok = 1;
+    for (int r = 0; r <= parts; r++) ok &= a[r] == b[r];
+    return ok;
+}
+
+static void test_quantiles(void)
+{
+    enum { N = 5003 };
+    double *x = malloc(N * sizeof *x);
+    srand(7);
+    /* coordinates of both signs over many decades, in random order */
+    for (int i = 0; i < N; i++)
+        x[i] = (rand() % 2 ? -1 : 1) * pow(10.0, -8 + 10.0 * rand() / (double)RAND_MAX);
+    for (int parts = 1; parts <= 64; parts = parts * 3 + 1) CHECK(same_cuts(x, N, parts));
+    /* a lattice: columns of equal coordinates (they stay together on one rank) */
+    for (int i = 0; i < N; i++) x[i] = 2.5e-6 * (double)((i * 7919) % 61) - 7.5e-5;
+    CHECK(same_cuts(x, N, 8));
+    CHECK(same_cuts(x, N, 61));
+    CHECK(same_cuts(x, N, 64));
+    /* one value; extremes; few coordinates for many slabs; none */
+    for (int i = 0; i < N; i++) x[i] = 0.125;
+    CHECK(same_cuts(x, N, 5));
+    x[0] = -1e308, x[1] = 1e308, x[2] = -0.0, x[3] = 5e-324;
+    CHECK(same_cuts(x, 4, 3));
+    CHECK(same_cuts(x, 3, 16));
+    CHECK(same_cuts(x, 0, 4));
+    free(x);
+}
+
+int main(int argc, char **argv)
+{
+    if (!lub_par_available()) {
+        printf("SKIP par_test: this lubkit was built without MPI\n");
+        return 0;
+    }
+    lub_par_start(&argc, &argv);
+    RUN(test_quantiles);
+    return test_summary();
+}
