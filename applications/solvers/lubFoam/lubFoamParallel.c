@@ -38,9 +38,10 @@ static void refuse_unparallel(const lubfoam_run *r, const lubfoam_functions *fos
                   sc->models_path, sc->fluid->name);
     if (sc->nlevels != 1)
         lub_fatal("%s: resolution levels do not run in parallel yet", sc->models_path);
-    if (m->c.lap_pressure == LUB_LAPLACIAN_LSMPS || m->c.lap_viscosity == LUB_LAPLACIAN_LSMPS)
-        lub_fatal("%s/system/schemes.yaml: the LSMPS Laplacian (laplacian: lsmps) does not run "
-                  "in parallel yet (its BiCGStab solve is serial): use laplacian: standard",
+    if (LUB_LAPLACIAN_FITTED(m->c.lap_pressure) || LUB_LAPLACIAN_FITTED(m->c.lap_viscosity))
+        lub_fatal("%s/system/schemes.yaml: the LSMPS Laplacians (laplacian: lsmps, "
+                  "lsmpsStabilized) do not run in parallel yet (its BiCGStab solve is serial): use "
+                  "laplacian: standard",
                   r->cs.root);
     const int implicit = m->c.viscosity == LUB_VISCOSITY_CN;
     if (m->c.p_solver.kind != LUB_LINSOLVER_PETSC ||
