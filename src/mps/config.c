@@ -13,6 +13,9 @@
  *                       # T-12 + geometric tests (test: sector | centroid | pnd)
  *     neighbourSkin:    0.2
  *     lsmpsDetMin:      1.0e-2
+ *     laplacian:        { viscosity: standard, pressure: standard, lsmpsRcond: 1e-3,
+ *                         stabilization: { strength: 1, onset: 3 } }
+ *                       # standard | lsmps | lsmpsStabilized (mps/lsmps.h)
  *     particleOrder:    cells        # cells | rows
  *     reorderInterval:  1
  *
@@ -60,6 +63,8 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->lap_viscosity = LUB_LAPLACIAN_STANDARD;
     c->lap_pressure = LUB_LAPLACIAN_STANDARD;
     c->lsmps_rcond = LUB_LSMPS_RCOND_MIN;
+    c->stab_strength = LUB_LSMPS_STAB_STRENGTH;
+    c->stab_onset = LUB_LSMPS_STAB_ONSET;
     c->order_rows = 0;
     c->dummy_velocity = LUB_DUMMY_MIRROR;
     c->p_solver = lub_linsolver_defaults();
@@ -148,11 +153,14 @@ static void read_schemes(lub_mps_config *c, const char *path)
     c->skin = lub_dict_real_or(r, "neighbourSkin", 0.0, LUB_BETWEEN(0.0, 1.0));
     c->lsmps_det_min =
         lub_dict_real_or(r, "lsmpsDetMin", LUB_MPS_LSMPS_DET_MIN, (lub_range){0.0, 1.0, 1, 1});
-    static const char *const lap[] = {"standard", "lsmps", NULL};
+    static const char *const lap[] = {"standard", "lsmps", "lsmpsStabilized", NULL};
     lub_node *ls = lub_dict_map_or(r, "laplacian");
     c->lap_viscosity = lub_dict_choice(ls, "viscosity", lap, c->lap_viscosity);
     c->lap_pressure = lub_dict_choice(ls, "pressure", lap, c->lap_pressure);
     c->lsmps_rcond = lub_dict_real_or(ls, "lsmpsRcond", c->lsmps_rcond, LUB_BETWEEN(1e-12, 0.5));
+    lub_node *stab = lub_dict_map_or(ls, "stabilization");
+    c->stab_strength = lub_dict_real_or(stab, "strength", c->stab_strength, LUB_BETWEEN(0.0, 1e6));
+    c->stab_onset = lub_dict_real_or(stab, "onset", c->stab_onset, LUB_BETWEEN(1.0, 1e6));
     static const char *const order[] = {"cells", "rows", NULL};
     c->order_rows = lub_dict_choice(r, "particleOrder", order, c->order_rows);
     c->reorder_interval =

@@ -4,7 +4,9 @@
 #include <math.h>
 #include <string.h>
 
+#include "core/error.h"
 #include "mps/lsq.h"
+#include "particles/weight.h"
 
 enum { MT = LUB_LSQ_MAX_TERMS };
 
@@ -28,56 +30,154 @@ static inline int basis(int dim, const double s[3], double p[MT])
     return 9;
 }
 
+/* p(r_ij / l0) of pair q */
+static inline void pair_basis(const lub_neighbours *nb, size_t q, int dim, double il0, double p[MT])
+{
+    const double s[3] = {nb->dx[0][q] * il0, nb->dx[1][q] * il0,
+                         dim == 3 ? nb->dx[2][q] * il0 : 0.0};
+    basis(dim, s, p);
+}
+
+/* c = M_i^-1 e of (LSMPS-L) for particle i from its neighbours of the kinds mj; returns 0
+ * (c untouched) where M_i is ill-conditioned (pivot ratio below rcond_min) */
+static int fit(const lub_neighbours *nb, const lub_mps_mask *mask, unsigned mj, size_t i, int dim,
+               double il0, double rcond_min, double c[MT])
+{
+    double M[MT][MT];
+    const int m = dim == 2 ? 5 : 9;
+    for (int a = 0; a < m; a++)
+        for (int b = 0; b < m; b++) M[a][b] = 0.0;
+    for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+        const double w = nb->w[q];
+        if (w <= 0 || !takes_part(mask, mj, nb->j[q])) continue;
+        double p[MT];
+        pair_basis(nb, q, dim, il0, p);
+        for (int a = 0; a < m; a++)
+            for (int b = 0; b <= a; b++) M[a][b] += w * p[a] * p[b];
+    }
+    for (int a = 0; a < m; a++)
+        for (int b = a + 1; b < m; b++) M[a][b] = M[b][a];
+    lub_lsq_factor F;
+    if (!(M[0][0] > 0) || !(lub_lsq_factorise(M, m, rcond_min, &F) >= rcond_min)) return 0;
+    double e[MT] = {0};
+    for (int a = dim; a < 2 * dim; a++) e[a] = 1.0;
+    lub_lsq_solve(&F, e, c);
+    return 1;
+}
+
 size_t lub_mps_lsmps_laplacian(const lub_neighbours *nb, const lub_mps_mask *mask, int dim,
                                double l0, double rcond_min, double *coef, uint8_t *flag)
 {
     const size_t n = nb->n;
     const double il0 = 1.0 / l0, scale = 2.0 / (l0 * l0);
     const unsigned mi = mask ? mask->i : LUB_MPS_ALL, mj = mask ? mask->j : LUB_MPS_ALL;
+    const int m = dim == 2 ? 5 : 9;
     if (rcond_min <= 0) rcond_min = LUB_LSMPS_RCOND_MIN;
     size_t nflag = 0;
 #pragma omp parallel for schedule(static) reduction(+ : nflag)
     for (size_t i = 0; i < n; i++) {
         if (!takes_part(mask, mi, i)) continue;
-        double M[MT][MT];
-        int m = dim == 2 ? 5 : 9;
-        for (int a = 0; a < m; a++)
-            for (int b = 0; b < m; b++) M[a][b] = 0.0;
-        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
-            const double w = nb->w[q];
-            if (w <= 0 || !takes_part(mask, mj, nb->j[q])) continue;
-            double s[3] = {nb->dx[0][q] * il0, nb->dx[1][q] * il0,
-                           dim == 3 ? nb->dx[2][q] * il0 : 0.0},
-                   p[MT];
-            basis(dim, s, p);
-            for (int a = 0; a < m; a++)
-                for (int b = 0; b <= a; b++) M[a][b] += w * p[a] * p[b];
-        }
-        for (int a = 0; a < m; a++)
-            for (int b = a + 1; b < m; b++) M[a][b] = M[b][a];
-        lub_lsq_factor F;
-        if (!(M[0][0] > 0) || !(lub_lsq_factorise(M, m, rcond_min, &F) >= rcond_min)) {
+        double c[MT];
+        if (!fit(nb, mask, mj, i, dim, il0, rcond_min, c)) {
             flag[i] = 1;
             nflag++;
             continue;
         }
-        /* c = M^-1 e, e = 1 on the squares */
-        double e[MT] = {0}, c[MT];
-        for (int a = dim; a < 2 * dim; a++) e[a] = 1.0;
-        lub_lsq_solve(&F, e, c);
         for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
             const double w = nb->w[q];
             if (w <= 0 || !takes_part(mask, mj, nb->j[q])) {
                 coef[q] = 0.0;
                 continue;
             }
-            double s[3] = {nb->dx[0][q] * il0, nb->dx[1][q] * il0,
-                           dim == 3 ? nb->dx[2][q] * il0 : 0.0},
-                   p[MT], cp = 0.0;
-            basis(dim, s, p);
+            double p[MT], cp = 0.0;
+            pair_basis(nb, q, dim, il0, p);
             for (int a = 0; a < m; a++) cp += c[a] * p[a];
             coef[q] = scale * w * cp;
         }
+        flag[i] = 0;
+    }
+    return nflag;
+}
+
+double lub_mps_lsmps_reference(int dim, double l0, double re)
+{
+    if ((dim != 2 && dim != 3) || !(l0 > 0) || !(re > 0))
+        lub_bug("LSMPS reference: dim %d, l0 %g, re %g", dim, l0, re);
+    /* M of (LSMPS-L) over every lattice node within re of the centre node, in l0 units */
+    const int r = (int)ceil(re / l0) + 1, rz = dim == 3 ? r : 0, m = dim == 2 ? 5 : 9;
+    double M[MT][MT] = {{0}};
+    for (int k = -rz; k <= rz; k++)
+        for (int j = -r; j <= r; j++)
+            for (int i = -r; i <= r; i++) {
+                if (i == 0 && j == 0 && k == 0) continue;
+                const double s[3] = {i, j, k};
+                const double w = lub_mps_weight(l0 * sqrt((double)(i * i + j * j + k * k)), re);
+                if (w <= 0) continue;
+                double p[MT];
+                basis(dim, s, p);
+                for (int a = 0; a < m; a++)
+                    for (int b = 0; b < m; b++) M[a][b] += w * p[a] * p[b];
+            }
+    lub_lsq_factor F;
+    if (!(lub_lsq_factorise(M, m, LUB_LSMPS_RCOND_MIN, &F) >= LUB_LSMPS_RCOND_MIN))
+        lub_bug("LSMPS reference: re %g l0 holds too few lattice neighbours", re / l0);
+    double e[MT] = {0}, c[MT], g = 0;
+    for (int a = dim; a < 2 * dim; a++) e[a] = 1.0;
+    lub_lsq_solve(&F, e, c);
+    for (int a = dim; a < 2 * dim; a++) g += c[a];
+    return g;
+}
+
+size_t lub_mps_lsmps_stabilized(const lub_neighbours *nb, const lub_mps_mask *mask, int dim,
+                                double l0, const lub_lsmps_stabilization *o, double *coef,
+                                uint8_t *flag, double *theta)
+{
+    const size_t n = nb->n;
+    const double il0 = 1.0 / l0, scale = 2.0 / (l0 * l0);
+    /* S_ij = sc w_ij (T-3) */
+    const double sc = 2.0 * dim / (o->lambda0 * o->n0), g0 = o->g0;
+    const unsigned mi = mask ? mask->i : LUB_MPS_ALL, mj = mask ? mask->j : LUB_MPS_ALL;
+    const int m = dim == 2 ? 5 : 9;
+    const double rcond_min = o->rcond_min > 0 ? o->rcond_min : LUB_LSMPS_RCOND_MIN;
+    if (!(g0 > 0) || !(o->n0 > 0) || !(o->lambda0 > 0) || !(o->strength >= 0) || !(o->onset >= 1))
+        lub_bug("stabilized LSMPS: g0 %g, n0 %g, lambda0 %g, strength %g, onset %g", g0, o->n0,
+                o->lambda0, o->strength, o->onset);
+    size_t nflag = 0;
+#pragma omp parallel for schedule(static) reduction(+ : nflag)
+    for (size_t i = 0; i < n; i++) {
+        if (!takes_part(mask, mi, i)) continue;
+        double c[MT];
+        if (!fit(nb, mask, mj, i, dim, il0, rcond_min, c)) {
+            flag[i] = 1;
+            if (theta) theta[i] = 0.0;
+            nflag++;
+            continue;
+        }
+        double g = 0;
+        for (int a = dim; a < 2 * dim; a++) g += c[a];
+        /* the bias penalty: theta = 1 / (1 + lambda g), lambda g0 = strength (rho - onset) */
+        const double rho = g / g0, over = rho - o->onset;
+        double th = over > 0 ? 1.0 / (1.0 + o->strength * over * rho) : 1.0;
+        /* LSMPS's coefficients A_ij (in coef), and the positivity bound on theta */
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+            const double w = nb->w[q];
+            if (w <= 0 || !takes_part(mask, mj, nb->j[q])) {
+                coef[q] = 0.0;
+                continue;
+            }
+            double p[MT], cp = 0.0;
+            pair_basis(nb, q, dim, il0, p);
+            for (int a = 0; a < m; a++) cp += c[a] * p[a];
+            coef[q] = scale * w * cp;
+            /* theta A + (1 - theta) S >= 0 for A < 0: theta <= S / (S - A) */
+            const double S = sc * w;
+            if (coef[q] < 0) th = fmin(th, S / (S - coef[q]));
+        }
+        /* (the max: the coefficient that bounds theta is zero but for round-off) */
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++)
+            if (nb->w[q] > 0 && takes_part(mask, mj, nb->j[q]))
+                coef[q] = fmax(0.0, th * coef[q] + (1.0 - th) * sc * nb->w[q]);
+        if (theta) theta[i] = th;
         flag[i] = 0;
     }
     return nflag;

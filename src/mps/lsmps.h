@@ -48,6 +48,66 @@
 size_t lub_mps_lsmps_laplacian(const lub_neighbours *nb, const lub_mps_mask *mask, int dim,
                                double l0, double rcond_min, double *coef, uint8_t *flag);
 
+/* Stabilized LSMPS (methods.md §1, (1.2); after Matsunaga and Koshizuka, CMAME 389 (2022)
+ * 114416, whose stabilisation terms are not printed in lubkit's sources: this is a design
+ * derived from their description, "artificial stabilisation terms in the least-squares
+ * objective, only near the surface").  The fit of (LSMPS-L) gets one more term, a penalty that
+ * pulls the fitted Laplacian towards the standard one (T-3) of the same neighbours,
+ *
+ *     J_i(a) = sum_j w_ij (f_j - f_i - a . p_ij)^2 + lambda_i (e . a - s_i)^2,
+ *     s_i = (l0^2 / 2) sum_j S_ij (f_j - f_i),   S_ij = 2d w_ij / (lambda0 n0)  [T-3's],
+ *
+ * whose minimiser gives (Sherman-Morrison on M_i + lambda_i e e^T)
+ *
+ *     lap f_i = sum_j L_ij (f_j - f_i),   L_ij = theta_i A_ij + (1 - theta_i) S_ij,
+ *     theta_i = 1 / (1 + lambda_i g_i),   g_i = e . M_i^-1 e,                     (SLSMPS)
+ *
+ * A_ij the coefficients of (LSMPS-L): a blend, still linear in f, on the same pairs.  g_i is
+ * the variance of the fitted Laplacian per unit noise in f (how badly the neighbourhood fixes
+ * it); on a full lattice g0 (lub_mps_lsmps_reference), within 0.9-1.2 g0 on particles jittered
+ * by 0.3 l0, 1.4-1.9 g0 next to a wall or one row below a free surface, 10-30 g0 on a
+ * free-surface particle, 300-700 g0 in a free sheet two particles thick.  lambda_i is the
+ * larger of
+ *
+ *   - the bias penalty  lambda_i g0 = strength max(0, g_i/g0 - onset): zero where the fit is
+ *     as well determined as onset times a lattice's (then theta = 1: exactly LSMPS, every
+ *     quadratic reproduced), growing with g_i, so that theta = 1 / (1 + strength rho (rho -
+ *     onset)), rho = g_i/g0, goes continuously to the standard row as M_i degenerates;
+ *   - the smallest penalty that makes every L_ij >= 0 (theta_i <= S_ij / (S_ij - A_ij) where
+ *     A_ij < 0): the row is then that of an M-matrix (positive diagonal sum_j L_ij, weakly
+ *     dominant), the property the solvers and the sign of a diffusion rely on.  The rows of
+ *     LSMPS itself are all positive inside the fluid (the weight T-6 on lattices jittered by
+ *     up to 0.3 l0, next to walls, below a plane surface), so this binds only at ragged
+ *     surfaces.
+ *
+ * Where the pivot ratio of M_i is below rcond_min, g_i is taken as infinite: theta = 0 and
+ * the particle is flagged (the caller's standard row, as lub_mps_lsmps_laplacian). */
+typedef struct {
+    double n0, lambda0; /* T-5, T-4 of the particles' level: S_ij = 2d w_ij / (lambda0 n0) */
+    double g0;          /* e . M^-1 e on the full lattice (lub_mps_lsmps_reference) */
+    double strength;    /* the bias penalty's slope (>= 0; 0: only the positivity bound) */
+    double onset;       /* g_i/g0 up to which the bias penalty is zero (>= 1) */
+    double rcond_min;   /* as lub_mps_lsmps_laplacian (<= 0: LUB_LSMPS_RCOND_MIN) */
+} lub_lsmps_stabilization;
+
+/* Defaults of strength and onset (system/schemes.yaml laplacian.stabilization): onset 3, not
+ * 2, because sheared particles that come within 0.7 l0 of a wall reach rho 2.4, where the
+ * blend with T-3 of their fluid and wall neighbours cost accuracy (tests/unit/mps_flow_test.c,
+ * the jittered channel: 0.78% at onset 2, 0.16% at 3). */
+#define LUB_LSMPS_STAB_STRENGTH 1.0
+#define LUB_LSMPS_STAB_ONSET    3.0
+
+/* g0 = e . M^-1 e of (LSMPS-L) (l0 units) for a particle of a full square (cubic) lattice of
+ * spacing l0 with every lattice neighbour within re (2-D, re = 3.1 l0: 0.1232). */
+double lub_mps_lsmps_reference(int dim, double l0, double re);
+
+/* The coefficients L_ij of (SLSMPS), as lub_mps_lsmps_laplacian (coef, flag, mask); theta
+ * (may be NULL) gets theta_i of each particle of mask->i (0 where flagged).  Returns the
+ * number flagged. */
+size_t lub_mps_lsmps_stabilized(const lub_neighbours *nb, const lub_mps_mask *mask, int dim,
+                                double l0, const lub_lsmps_stabilization *o, double *coef,
+                                uint8_t *flag, double *theta);
+
 /* lap f_i = sum_q coef[q] (f_j - f_i) for the particles of mask->i whose flag is 0 (the
  * others untouched), e.g. to check the coefficients on a field. */
 void lub_mps_lsmps_apply(const lub_neighbours *nb, const lub_mps_mask *mask, const double *coef,

@@ -64,7 +64,10 @@ enum { LUB_SOURCE_PND = 0, LUB_SOURCE_MIXED = 1 };
 enum { LUB_VISCOSITY_NONE = 0, LUB_VISCOSITY_EXPLICIT = 1, LUB_VISCOSITY_CN = 2 };
 enum { LUB_NEGATIVE_KEEP = 0, LUB_NEGATIVE_CLIP = 1, LUB_NEGATIVE_CAVITATION = 2 };
 enum { LUB_SURFACE_SECTOR = 0, LUB_SURFACE_CENTROID = 1, LUB_SURFACE_PND = 2 };
-enum { LUB_LAPLACIAN_STANDARD = 0, LUB_LAPLACIAN_LSMPS = 1 };
+/* laplacian.viscosity / .pressure: T-3, LSMPS (1.1), stabilized LSMPS (1.2) */
+enum { LUB_LAPLACIAN_STANDARD = 0, LUB_LAPLACIAN_LSMPS = 1, LUB_LAPLACIAN_STABILIZED = 2 };
+/* the fitted (LSMPS) Laplacians: pair coefficients, nonsymmetric rows */
+#define LUB_LAPLACIAN_FITTED(k) ((k) != LUB_LAPLACIAN_STANDARD)
 /* dummyVelocity: the wall's U, the mirror ghost 2 U - u_i, or the no-slip profile extrapolated */
 enum { LUB_DUMMY_WALL = 0, LUB_DUMMY_MIRROR = 1, LUB_DUMMY_EXTRAPOLATE = 2, LUB_DUMMY_FLUX = 3 };
 /* extrapolate and flux continue the no-slip profile (and need its curvature) */
@@ -94,6 +97,8 @@ typedef struct {
     int lap_viscosity;      /* LUB_LAPLACIAN_*: the Laplacian of the viscous term */
     int lap_pressure;       /* LUB_LAPLACIAN_*: the Laplacian of the pressure equation */
     double lsmps_rcond;     /* LSMPS Laplacian: smallest pivot ratio of M_i (mps/lsmps.h) */
+    double stab_strength;   /* stabilized LSMPS: the bias penalty's strength and onset */
+    double stab_onset;      /* (lub_lsmps_stabilization, mps/lsmps.h) */
     int reorder_interval;   /* steps between sorts of the particles (0: never) */
     int order_rows;         /* the sort: 0 cell order, 1 lattice rows of l0 */
     int dummy_velocity;     /* LUB_DUMMY_*: the dummies' velocity in the viscous term (step.c,
@@ -149,6 +154,7 @@ typedef struct {
     lub_solve_result p, v[3];
     size_t nsurface, nunknowns, nfallback, nrebuild;
     size_t nlapfallback;            /* LSMPS Laplacian rows taken as standard (lsmps.h) */
+    size_t nlapblend;               /* stabilized LSMPS rows blended with T-3 (theta < 1) */
     size_t nisolated;               /* particles of groups touching no Dirichlet particle, taken as
                                        surface particles (step.c, isolated_groups) */
     unsigned long long isolated_id; /* the id of the first of them */
@@ -212,6 +218,7 @@ struct lub_mps {
     double *lapc;
     size_t lapc_cap;
     uint8_t *lapflag;
+    double lsmps_g0; /* stabilized LSMPS: g0 of the level (lub_mps_lsmps_reference) */
     lub_csr A2;
     lub_bicgstab_work bw;
     double *dinv;
@@ -240,7 +247,7 @@ struct lub_mps {
                         step (particle extra field "surface": saved and reordered), else NULL */
     int surf_fresh;  /* the start's particles carry no "surface" field: the first step takes
                         the geometric test alone */
-    double *lap;
+    double *lap;     /* scratch: theta_i of the last stabilized LSMPS coefficients (step.c) */
     /* Given particles: the pressure-equation contributions (and the velocities) of a model,
      * set before the step (multiResolution's fixed band, T-25, T-26).  Reordered with the
      * particles; NULL unless config.fixed_flags. */

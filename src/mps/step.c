@@ -110,6 +110,7 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
     m->surface = lub_calloc(n ? n : 1, 1);
     m->anchor = lub_calloc(n ? n : 1, 1);
     m->lapflag = lub_calloc(n ? n : 1, 1);
+    m->lsmps_g0 = lub_mps_lsmps_reference(m->dim, m->l0, m->re);
     {
         const int h = (int)ceil(m->re / m->l0), hz = m->dim == 3 ? h : 0;
         m->nlattice = 0;
@@ -283,8 +284,8 @@ static void grow_slab(void *ctx, size_t n, const char *what)
 
 void lub_mps_set_parallel(lub_mps *m, lub_par *d)
 {
-    if (m->fixed || m->c.lap_pressure == LUB_LAPLACIAN_LSMPS ||
-        m->c.lap_viscosity == LUB_LAPLACIAN_LSMPS)
+    if (m->fixed || LUB_LAPLACIAN_FITTED(m->c.lap_pressure) ||
+        LUB_LAPLACIAN_FITTED(m->c.lap_viscosity))
         lub_bug("lub_mps_set_parallel: given particles or an LSMPS Laplacian (not parallel)");
     m->par = d;
     d->grow = grow_slab;
@@ -412,16 +413,17 @@ static void smooth_fluid(lub_mps *m, double *const f[3], double *const out[3])
     }
 }
 
-/* ---- the LSMPS Laplacian (laplacian.viscosity / .pressure: lsmps, mps/lsmps.h) ---------
+/* ---- the LSMPS Laplacians (laplacian.viscosity / .pressure: lsmps or lsmpsStabilized, kind;
+ * mps/lsmps.h) ---------------------------------------------------------------------------
  *
- * Its pair coefficients L_ij for the fluid particles from their fluid and wall neighbours
+ * Their pair coefficients L_ij for the fluid particles from their fluid and wall neighbours
  * (dummy particles carry neither a velocity of the flow nor a pressure: the wall particles'
  * prescribed values enter the fit as Dirichlet values instead of the dummies' mirror
  * images).  Rows whose moment matrix is ill-conditioned (m->lapflag) keep the standard T-3
  * row.  The nonsymmetric system is solved by BiCGStab, preconditioned by the solver of the
  * standard matrix of the same particles (its AMG, IC(0), Jacobi or CHOLMOD factor), which
  * lies spectrally close to it. */
-static void lsmps_coefficients(lub_mps *m)
+static void lsmps_coefficients(lub_mps *m, int kind)
 {
     const lub_particles *P = m->P;
     if (m->lapc_cap < m->nb.cap_pairs) { /* the lists grew (rare after the first steps) */
@@ -430,6 +432,20 @@ static void lsmps_coefficients(lub_mps *m)
         m->lapc = lub_malloc(m->lapc_cap * sizeof *m->lapc);
     }
     lub_mps_mask lm = {P->kind, K_FLUID, K_FLUID | K_WALL};
+    if (kind == LUB_LAPLACIAN_STABILIZED) {
+        /* (1.2): the blend with T-3 takes care of the surface and of the sign; the rows whose
+         * M_i is singular are flagged (the standard row, as below) */
+        const lub_lsmps_stabilization o = {
+            m->n0, m->lambda0, m->lsmps_g0, m->c.stab_strength, m->c.stab_onset, m->c.lsmps_rcond};
+        m->st.nlapfallback +=
+            lub_mps_lsmps_stabilized(&m->nb, &lm, m->dim, m->l0, &o, m->lapc, m->lapflag, m->lap);
+        size_t nblend = 0;
+#pragma omp parallel for schedule(static) reduction(+ : nblend)
+        for (size_t i = 0; i < P->n; i++)
+            nblend += P->kind[i] == LUB_FLUID && !m->lapflag[i] && m->lap[i] < 1.0;
+        m->st.nlapblend += nblend;
+        return;
+    }
     lub_mps_lsmps_laplacian(&m->nb, &lm, m->dim, m->l0, m->c.lsmps_rcond, m->lapc, m->lapflag);
     /* near a free surface (PND of all neighbours, dummies included, below beta n0) the fit
      * extrapolates from a one-sided neighbourhood: its second derivatives are poor and the
@@ -607,11 +623,11 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
         const double *b[3] = {m->bv[0], m->bv[1], m->bv[2]};
         double *x[3] = {m->xv[0], m->xv[1], m->xv[2]};
         lub_solve_status s;
-        if (m->c.lap_viscosity == LUB_LAPLACIAN_LSMPS) {
+        if (LUB_LAPLACIAN_FITTED(m->c.lap_viscosity)) {
             /* (T-31) with the LSMPS Laplacian: u*_i - h sum_j L_ij (u*_j - u*_i) = u_i +
              * h sum_j L_ij (u_j - u_i) + dt (g - G/rho), h = dt nu / 2, the wall particles'
              * velocities known; the rows of flagged particles keep T-3's (above) */
-            lsmps_coefficients(m);
+            lsmps_coefficients(m, m->c.lap_viscosity);
             const double h = 0.5 * dt * m->c.nu;
             lub_csr_begin(&m->A2, nf);
             for (int r = 0; r < nf; r++)
@@ -1140,12 +1156,12 @@ assemble:
             goto assemble;
         }
     }
-    const int lsmps = m->c.lap_pressure == LUB_LAPLACIAN_LSMPS;
+    const int lsmps = LUB_LAPLACIAN_FITTED(m->c.lap_pressure);
     if (lsmps && nu > 0) {
         /* the LSMPS Laplacian in the fluid rows: sum_j L_ij (P_i - P_j) + alpha P_i = b_i, the
          * Dirichlet neighbours' given pressures moved to b; the wall particles' rows (and the
          * flagged fluid rows) stay those of T-10 above, which A keeps for the preconditioner */
-        lsmps_coefficients(m);
+        lsmps_coefficients(m, m->c.lap_pressure);
         lub_csr_begin(&m->A2, nu);
         for (int r = 0; r < nu; r++)
             lub_csr_set_row_length(&m->A2, r, lub_csr_row_length(&m->A, r));

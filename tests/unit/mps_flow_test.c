@@ -162,6 +162,20 @@ static void test_hydrostatic_lsmps(void)
                 0.1, 1e-4, LUB_LAPLACIAN_LSMPS);
 }
 
+/* The same with the stabilized LSMPS Laplacian (laplacian: lsmpsStabilized; lsmps.h): LSMPS
+ * blended towards T-3 by the fit's own conditioning, no switch at the free surface. */
+static void test_hydrostatic_stabilized(void)
+{
+    hydrostatic("dimension: 2\n"
+                "l0: 0.005\n"
+                "domain: { min: [-0.02, -0.02], max: [0.12, 0.2] }\n"
+                "walls:\n"
+                "  tank: { type: box, min: [0, 0], max: [0.1, 0.2], fluid: inside }\n"
+                "fluid:\n"
+                "  - { type: box, min: [0, 0], max: [0.1, 0.1] }\n",
+                0.1, 1e-4, LUB_LAPLACIAN_STABILIZED);
+}
+
 /* 3-D: a tank 10 x 10 particles wide, 12 deep (l0 = 8 mm).  The error falls with the
  * resolution (rel L2 1.99% at 8 x 8 x 10, l0 = 1 cm; 1.36% here): at 8 across, the
  * particles more than 2 l0 from the walls and 3 l0 below the surface are too few (61) to
@@ -381,12 +395,14 @@ static void test_step_bearing_mixed(void)
 /* Plane Poiseuille flow between walls 8 l0 apart, the fluid particles jittered by up to
  * 0.2 l0 at the start (a fixed sequence): the standard viscous Laplacian (T-3), of order zero
  * on disordered particles, misses the parabola by 2% (relative L2 of the binned profile), the
- * LSMPS one (laplacian.viscosity: lsmps) keeps it within 0.5%.  Both against f/(2 nu) y (H - y),
- * after three diffusion times H^2/nu. */
+ * LSMPS one (laplacian.viscosity: lsmps) and the stabilized one (lsmpsStabilized: 0.16%; with
+ * the penalty's onset at 2 instead of 3 it blended the particles that came within 0.7 l0 of a
+ * wall towards T-3 of their fluid and wall neighbours, which lacks the dummies: 0.78%) keep
+ * it within 0.5%.  All against f/(2 nu) y (H - y), after three diffusion times H^2/nu. */
 static void test_poiseuille_jittered(void)
 {
-    double err[2];
-    for (int lap = 0; lap < 2; lap++) {
+    double err[3];
+    for (int lap = 0; lap < 3; lap++) {
         const double H = 0.008, l0 = 0.001, nu = 1e-4;
         lub_particles P = {0};
         lub_geometry g;
@@ -424,12 +440,16 @@ static void test_poiseuille_jittered(void)
         CHECK(run(&m, dt, (long)(3 * H * H / nu / dt)) == 0);
         err[lap] = profile_error(&P, 1, poiseuille, &f);
         printf("  Poiseuille on jittered particles, %s viscous Laplacian: relative L2 %.4f\n",
-               lap ? "LSMPS" : "standard", err[lap]);
+               lap == LUB_LAPLACIAN_STABILIZED ? "stabilized LSMPS"
+               : lap                           ? "LSMPS"
+                                               : "standard",
+               err[lap]);
         lub_mps_free(&m);
         lub_particles_free(&P);
         lub_geometry_free(&g);
     }
     CHECK(err[1] < 0.005);
+    CHECK(err[2] < 0.005);
     CHECK(err[0] > 0.01);
 }
 
@@ -810,6 +830,7 @@ int main(void)
     RUN(test_step_bearing_mixed);
     RUN(test_poiseuille_jittered);
     RUN(test_hydrostatic_lsmps);
+    RUN(test_hydrostatic_stabilized);
     RUN(test_surface_film);
     RUN(test_compression);
     RUN(test_dummy_velocity);
