@@ -150,6 +150,13 @@ void *lub_realloc(void *p, size_t n)
     return q;
 }
 
+void *lub_regrow(void *p, size_t old, size_t cap, size_t size)
+{
+    char *q = lub_realloc(p, cap * size);
+    if (cap > old) memset(q + old * size, 0, (cap - old) * size);
+    return q;
+}
+
 char *lub_strdup(const char *s)
 {
     size_t n = strlen(s) + 1;

@@ -74,6 +74,9 @@ void lub_error_uncatch(void);
 void *lub_malloc(size_t n);
 void *lub_calloc(size_t n, size_t size);
 void *lub_realloc(void *p, size_t n);
+/* An array of old elements of size bytes (NULL: none yet) grown to cap elements, the new tail
+ * zeroed, so that no uninitialised memory is read or written to a file. */
+void *lub_regrow(void *p, size_t old, size_t cap, size_t size);
 char *lub_strdup(const char *s);
 
 #endif

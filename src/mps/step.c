@@ -219,12 +219,10 @@ void lub_mps_relist(lub_mps *m)
 
 /* One per-particle array from m->cap to cap elements (NULL stays NULL), the new tail zeroed
  * as lub_mps_init's calloc left it. */
+/* lub_regrow, an array the configuration does not use (NULL) left out */
 static void *regrow(void *a, size_t old, size_t cap, size_t size)
 {
-    if (!a) return NULL;
-    char *b = lub_realloc(a, cap * size);
-    memset(b + old * size, 0, (cap - old) * size);
-    return b;
+    return a ? lub_regrow(a, old, cap, size) : NULL;
 }
 
 void lub_mps_resize(lub_mps *m, size_t cap)

@@ -58,30 +58,21 @@ void lub_particles_free(lub_particles *P)
     memset(P, 0, sizeof *P);
 }
 
-/* Grow one array from P->cap to cap elements of size bytes, zeroing the new tail so that no
- * uninitialised memory is ever written to a file. */
-static void *grow(void *a, size_t old_cap, size_t cap, size_t size)
-{
-    char *b = lub_realloc(a, cap * size);
-    memset(b + old_cap * size, 0, (cap - old_cap) * size);
-    return b;
-}
-
 void lub_particles_reserve(lub_particles *P, size_t cap)
 {
     if (cap <= P->cap) return;
     size_t old = P->cap;
     for (int d = 0; d < 3; d++) {
-        P->x[d] = grow(P->x[d], old, cap, sizeof(double));
-        P->u[d] = grow(P->u[d], old, cap, sizeof(double));
+        P->x[d] = lub_regrow(P->x[d], old, cap, sizeof(double));
+        P->u[d] = lub_regrow(P->u[d], old, cap, sizeof(double));
     }
-    P->p = grow(P->p, old, cap, sizeof(double));
-    P->kind = grow(P->kind, old, cap, sizeof(uint8_t));
-    P->patch = grow(P->patch, old, cap, sizeof(uint16_t));
-    P->level = grow(P->level, old, cap, sizeof(uint8_t));
-    P->id = grow(P->id, old, cap, sizeof(uint64_t));
+    P->p = lub_regrow(P->p, old, cap, sizeof(double));
+    P->kind = lub_regrow(P->kind, old, cap, sizeof(uint8_t));
+    P->patch = lub_regrow(P->patch, old, cap, sizeof(uint16_t));
+    P->level = lub_regrow(P->level, old, cap, sizeof(uint8_t));
+    P->id = lub_regrow(P->id, old, cap, sizeof(uint64_t));
     for (int e = 0; e < P->nextra; e++)
-        P->extra[e].v = grow(P->extra[e].v, old, cap, sizeof(double));
+        P->extra[e].v = lub_regrow(P->extra[e].v, old, cap, sizeof(double));
     P->cap = cap;
 }
 
