@@ -442,6 +442,14 @@ void lub_par_init_sfc(lub_par *d, int dim, double cell, const double lo[3], cons
         if (d->ncell[k] > most) most = d->ncell[k];
     }
     while ((1L << d->bits) < most) d->bits++;
+    /* the curve's axes: an axis of a few cells against the longest (a film's thickness:
+     * fewer than a quarter as many) is left out, its cells across the film one key, so that
+     * the ranges are patches of the film's area through its thickness; a curve through the
+     * cube of the longest side would wander out of the film and back, and its ranges would
+     * be scattered pieces (the 3-D roller at h0/2, 36 x 3 x 16 cells on 4 ranks: a halo of
+     * 43% of the owned particles with the 3-D curve, against 22% of slabs: measured) */
+    for (int k = 0; k < dim; k++)
+        if (4 * d->ncell[k] > most) d->curve[d->ncurve++] = k;
     d->kcut[d->size] = UINT64_MAX;
 }
 
@@ -510,8 +518,9 @@ static int cell_index(const lub_par *d, int k, double x)
 
 static uint64_t cell_key(const lub_par *d, const int c[3])
 {
-    const uint32_t u[3] = {(uint32_t)c[0], (uint32_t)c[1], (uint32_t)c[2]};
-    return lub_par_hilbert(u, d->dim, d->bits);
+    uint32_t u[3] = {0, 0, 0};
+    for (int j = 0; j < d->ncurve; j++) u[j] = (uint32_t)c[d->curve[j]];
+    return lub_par_hilbert(u, d->ncurve, d->bits);
 }
 
 static uint64_t particle_key(const lub_par *d, const lub_particles *P, size_t i)

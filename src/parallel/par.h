@@ -15,6 +15,9 @@
  * its owned particles first in its lub_particles (indices 0 .. nown-1) and, during a step,
  * copies of the other ranks' particles within `width` of its slab (the halo, appended after
  * them: nown .. nown+nhalo-1), so that every neighbour sum of an owned particle is complete.
+ * An axis of fewer than a quarter of the longest's cells (a film's thickness) is left out
+ * of the curve: the cells across it share a key, and the ranges are patches of the film
+ * through its thickness.
  * With sfc a particle goes to the halo of every other rank owning a cell within width of it
  * (the cells within ceil(width / cell) of its own along each axis, their owners by their
  * keys, cached per cell between re-cuts; across a periodic direction with the minimum
@@ -163,6 +166,7 @@ typedef struct {
     double clo[3], csize[3]; /* the box's lower corner, the cells' size (at least the cell asked) */
     double cperiod[3];       /* the period along a periodic axis */
     int bits;                /* of the curve along each axis: 2^bits >= ncell */
+    int ncurve, curve[3];    /* the curve's axes (a film's few cells across left out) */
     uint64_t *kcut;          /* [size + 1]: rank r owns the keys [kcut[r], kcut[r+1]) */
     int reach[3];            /* the halo's cells each way: ceil(width / csize) */
     int nnb;                 /* neighbour cells per cell, prod (2 reach + 1) */

@@ -134,10 +134,15 @@ void lubfoam_parallel_setup(lubfoam_run *r, const lubfoam_functions *fos)
                  d->ncell[1], d->ncell[2]);
         double h = d->csize[0];
         for (int k = 1; k < d->dim; k++) h = fmin(h, d->csize[k]);
+        char axes[16] = "";
+        for (int j = 0; j < d->ncurve; j++)
+            snprintf(axes + strlen(axes), sizeof axes - strlen(axes), "%s%c", j ? ", " : "",
+                     "xyz"[d->curve[j]]);
         lub_message("Parallel: %d ranks, sfc: ranges of a Hilbert curve over %s cells of at "
-                    "least %g m, %zu particles, at most %zu per rank (mean %.0f), halo width "
-                    "%g m",
-                    size, cells, h, total, r->most, (double)total / size, d->width);
+                    "least %g m (the curve through %s%s), %zu particles, at most %zu per rank "
+                    "(mean %.0f), halo width %g m",
+                    size, cells, h, axes, d->ncurve < d->dim ? "; the cells across it one key" : "",
+                    total, r->most, (double)total / size, d->width);
         lub_message("Ranges: each rank's particles and solver sized for its range of the curve, "
                     "its halo and a margin of %g: capacity at most %.0f particles per rank, "
                     "%.1f%% of the case",
