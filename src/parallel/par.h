@@ -1,14 +1,27 @@
 /* lubkit parallel: a run on several MPI processes (ranks), `mpirun -np N lubFoam -parallel`
  * (issue 31; the plan and its state: doc/parallel.md).
  *
- * Decomposition: slabs along one axis (system/decomposeParDict.yaml, method slabs).  Rank r
- * owns the particles (fluid, wall and dummy) whose coordinate on the axis lies in
- * [cut[r], cut[r+1]); the cuts are set at the start, and again when re-balancing, at the
- * quantiles of the coordinate over all ranks (every rank holds about N / P particles),
- * found by a parallel selection that holds no rank's copy of all N.  Each rank keeps
+ * Decomposition (system/decomposeParDict.yaml, method): slabs along one axis, or ranges of
+ * a space-filling curve (sfc).  Slabs: rank r owns the particles (fluid, wall and dummy)
+ * whose coordinate on the axis lies in [cut[r], cut[r+1]).  sfc: the box is divided into
+ * cells of about the halo's width, each cell has its index along a Hilbert curve (its key,
+ * lub_par_hilbert), and rank r owns the particles whose cell's key lies in
+ * [kcut[r], kcut[r+1]): a contiguous stretch of the curve, a compact patch of the case
+ * whatever its shape (a bearing's ring, a thin film), where a slab of a ring holds unequal
+ * arcs and thin slabs a halo as large as themselves.  The cuts (cut or kcut) are set at the
+ * start, and again when re-balancing, at the quantiles of the coordinate or key over all
+ * ranks (every rank holds about N / P particles), found by a parallel selection that holds
+ * no rank's copy of all N.  Each rank keeps
  * its owned particles first in its lub_particles (indices 0 .. nown-1) and, during a step,
  * copies of the other ranks' particles within `width` of its slab (the halo, appended after
  * them: nown .. nown+nhalo-1), so that every neighbour sum of an owned particle is complete.
+ * An axis of fewer than a quarter of the longest's cells (a film's thickness) is left out
+ * of the curve: the cells across it share a key, and the ranges are patches of the film
+ * through its thickness.
+ * With sfc a particle goes to the halo of every other rank owning a cell within width of it
+ * (the cells within ceil(width / cell) of its own along each axis, their owners by their
+ * keys, cached per cell between re-cuts; across a periodic direction with the minimum
+ * image).
  *
  *     lub_par_start(&argc, &argv);              first thing in main (MPI_Init)
  *     lub_par_init(&d, axis, width, lo, hi, periodic_axis);
@@ -48,7 +61,7 @@
 /* system/decomposeParDict.yaml (etc/templates/decomposeParDict.yaml):
  *
  *     numberOfSubdomains: 2          # = mpirun -np
- *     method: slabs                  # the only one yet
+ *     method: slabs                  # slabs | sfc (ranges of a Hilbert curve over cells)
  *     slabs: { axis: auto }          # auto (the fluid's longest) | x | y | z
  *     balance: { interval: 0, imbalance: 0.1 }   # re-cut every interval steps (0: never)
  *                                    # when the fullest rank holds > (1 + imbalance) x mean
@@ -59,7 +72,9 @@
  *
  * Read from path for a dim-D case; nranks > 0: numberOfSubdomains must equal it (an error
  * at its line naming both otherwise).  Fatal (exit 1) at file:line on bad input. */
+enum { LUB_PAR_SLABS, LUB_PAR_SFC };
 typedef struct {
+    int method;       /* LUB_PAR_SLABS, LUB_PAR_SFC */
     int axis;         /* 0, 1, 2; -1: auto */
     long interval;    /* balance.interval (0: never) */
     double imbalance; /* balance.imbalance */
@@ -112,8 +127,9 @@ int lub_par_first(int flag);
 void lub_par_barrier(void);
 
 typedef struct {
-    int axis;          /* 0, 1, 2 */
-    double width;      /* halo: particles within width of another rank's slab */
+    int method;        /* LUB_PAR_SLABS, LUB_PAR_SFC */
+    int axis;          /* 0, 1, 2 (slabs) */
+    double width;      /* halo: particles within width of another rank's slab or cells */
     int periodic;      /* the axis is periodic (period = hi - lo) */
     double lo, period; /* the box along the axis */
     int rank, size;
@@ -143,12 +159,41 @@ typedef struct {
     void *grow_ctx;
     double margin; /* the room a re-size leaves beyond n (decomposeParDict margin) */
     long nresized; /* re-sizes so far */
+    /* sfc: the cells of the curve and the ranges of keys */
+    int dim;
+    int ncell[3];            /* cells along each axis */
+    int cper[3];             /* the axis is periodic */
+    double clo[3], csize[3]; /* the box's lower corner, the cells' size (at least the cell asked) */
+    double cperiod[3];       /* the period along a periodic axis */
+    int bits;                /* of the curve along each axis: 2^bits >= ncell */
+    int ncurve, curve[3];    /* the curve's axes (a film's few cells across left out) */
+    uint64_t *kcut;          /* [size + 1]: rank r owns the keys [kcut[r], kcut[r+1]) */
+    int reach[3];            /* the halo's cells each way: ceil(width / csize) */
+    int nnb;                 /* neighbour cells per cell, prod (2 reach + 1) */
+    int *nb_owner;           /* the cache: [ncache][nnb] owners of a cell's neighbours (-1: none) */
+    uint64_t *nb_tag;        /* [ncache] the cell (its linear index + 1) an entry holds, 0: none */
+    size_t ncache;
+    uint64_t *pairs; /* the halo's (rank, particle) pairs before their order by rank */
+    size_t pairs_cap;
+    size_t *mark; /* [size] the last particle (+ 1) sent to each rank's halo */
 } lub_par;
 
 /* Slabs of the axis (0, 1, 2) of the box [lo, hi] (periodic: the axis is periodic), halo
  * width (the neighbour search's radius re (1 + skin) and a margin). */
 void lub_par_init(lub_par *d, int axis, double width, double lo, double hi, int periodic);
+/* Ranges of a Hilbert curve over the cells of the dim-D box [lo, hi] (periodic[k]: axis k
+ * periodic), each cell at least `cell` wide (the halo's width, known or foreseen: the halo
+ * reaches as many cells as it needs when d->width is set otherwise). */
+void lub_par_init_sfc(lub_par *d, int dim, double cell, const double lo[3], const double hi[3],
+                      const int periodic[3]);
 void lub_par_free(lub_par *d);
+/* The index along the Hilbert curve of the cell c (dim 2 or 3, each coordinate below
+ * 2^bits, dim x bits <= 63): the curve visits every cell of the 2^bits cube once, each step
+ * to a cell sharing a face (J. Skilling, Programming the Hilbert curve, AIP Conf. Proc. 707,
+ * 2004: the transposed index, its bits then interleaved). */
+uint64_t lub_par_hilbert(const uint32_t c[3], int dim, int bits);
+/* The rank owning particle i of P (its slab, or its cell's range of keys). */
+int lub_par_owner_of(const lub_par *d, const lub_particles *P, size_t i);
 /* The longest axis of the fluid particles' bounding box over all ranks' particles P.
  * Collective. */
 int lub_par_longest_axis(const lub_particles *P);
@@ -172,8 +217,9 @@ size_t lub_par_distribute(lub_par *d, const lub_particles *S, const uint64_t *pl
  * the capacity of the slab before the solver is built.  Collective. */
 size_t lub_par_halo_count(lub_par *d, const lub_particles *P);
 /* Q (no storage on entry) gets a copy of the other ranks' owned particles with want[i] set
- * that lie within width of this rank's slab (the period taken into account): a start-up
- * check of pairs across the slabs (movingWalls: the walls meeting).  Collective. */
+ * that lie within width of this rank's slab (sfc: of the bounding box of its owned
+ * particles; the period taken into account): a start-up check of pairs across the ranks
+ * (movingWalls: the walls meeting).  Collective. */
 void lub_par_collect(lub_par *d, const lub_particles *P, double width, const uint8_t *want,
                      lub_particles *Q);
 /* Re-balancing (P->n = nown): when the fullest rank holds more than (1 + imbalance) times

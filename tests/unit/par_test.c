@@ -1,4 +1,7 @@
-/* parallel/par: the slabs' cuts by a parallel selection (lub_par_quantiles) against the
+/* parallel/par: the Hilbert curve of the sfc decomposition (lub_par_hilbert) against the
+ * definition of a Hilbert curve (every cell of the 2^bits square or cube once, each step to a
+ * face neighbour, beginning at the origin); the slabs' cuts by a parallel selection
+ * (lub_par_quantiles) against the
  * order statistics of the whole sorted set, which the all-gather it replaced computed: on one
  * process (MPI's singleton start, no mpirun) the selection runs its bisection and reductions
  * as on many ranks, with every coordinate here.  The cuts over several ranks, and the start
@@ -65,11 +68,55 @@ static void test_quantiles(void)
     free(x);
 }
 
+/* The curve over the 2^bits cube of dim dimensions: the keys are 0 .. 2^(dim bits) - 1, each
+ * once (a permutation: the curve visits every cell once), consecutive keys are cells one
+ * face apart (Manhattan distance 1: the curve never jumps), key 0 is the origin. */
+static int hilbert_curve_ok(int dim, int bits)
+{
+    const uint64_t side = 1ull << bits, n = dim == 3 ? side * side * side : side * side;
+    uint32_t(*cell)[3] = malloc(n * sizeof *cell);
+    unsigned char *seen = calloc(n, 1);
+    int ok = 1;
+    for (uint64_t q = 0; q < n; q++) {
+        const uint32_t c[3] = {(uint32_t)(q % side), (uint32_t)(q / side % side),
+                               dim == 3 ? (uint32_t)(q / side / side) : 0};
+        const uint64_t k = lub_par_hilbert(c, dim, bits);
+        if (k >= n || seen[k]) {
+            ok = 0;
+            break;
+        }
+        seen[k] = 1;
+        for (int d = 0; d < 3; d++) cell[k][d] = c[d];
+    }
+    for (uint64_t k = 1; ok && k < n; k++) {
+        long step = 0;
+        for (int d = 0; d < 3; d++) step += labs((long)cell[k][d] - (long)cell[k - 1][d]);
+        ok = step == 1;
+    }
+    if (ok) ok = cell[0][0] == 0 && cell[0][1] == 0 && cell[0][2] == 0;
+    free(cell);
+    free(seen);
+    return ok;
+}
+
+static void test_hilbert(void)
+{
+    for (int bits = 1; bits <= 6; bits++) CHECK(hilbert_curve_ok(2, bits));
+    for (int bits = 1; bits <= 5; bits++) CHECK(hilbert_curve_ok(3, bits));
+    /* the largest cubes of the key's 63 bits: the corners' keys in range, distinct */
+    const uint32_t a[3] = {0, 0, 0}, b[3] = {(1u << 21) - 1, (1u << 21) - 1, (1u << 21) - 1};
+    CHECK(lub_par_hilbert(a, 3, 21) == 0);
+    CHECK(lub_par_hilbert(b, 3, 21) < (1ull << 63) && lub_par_hilbert(b, 3, 21) > 0);
+    const uint32_t e[3] = {(1u << 30) - 1, 0, 0};
+    CHECK(lub_par_hilbert(e, 2, 30) == (1ull << 60) - 1); /* the curve ends at (side-1, 0) */
+}
+
 int main(int argc, char **argv)
 {
+    RUN(test_hilbert);
     if (!lub_par_available()) {
-        printf("SKIP par_test: this lubkit was built without MPI\n");
-        return 0;
+        printf("SKIP par_test (the selection): this lubkit was built without MPI\n");
+        return test_summary();
     }
     lub_par_start(&argc, &argv);
     RUN(test_quantiles);

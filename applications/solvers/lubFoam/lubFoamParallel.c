@@ -54,9 +54,21 @@ void lubfoam_parallel_start(lubfoam_run *r, const lub_geometry *geo)
 void lubfoam_parallel_distribute(lubfoam_run *r, const lub_geometry *geo, const lub_particles *S,
                                  const uint64_t *place, const char *path)
 {
-    const int axis = r->pd.axis < 0 ? lub_par_longest_axis(S) : r->pd.axis;
-    /* the halo's width is the solver's (lubfoam_parallel_capacity) */
-    lub_par_init(&r->par, axis, 0.0, geo->dmin[axis], geo->dmax[axis], geo->periodic[axis]);
+    if (r->pd.method == LUB_PAR_SFC) {
+        /* the curve's cells as wide as the halo will be: the neighbour lists' radius of the
+         * schemes and l0 (a model's wider lists, known later, make the halo reach further
+         * cells: lub_par's halo takes as many as the width needs) */
+        lub_mps_config c;
+        lub_mps_config_defaults(&c);
+        lub_mps_config_read(&c, r->cs.root);
+        const double l0 = S->levels[0].l0;
+        lub_par_init_sfc(&r->par, geo->dim, lub_mps_list_radius(&c, l0) + l0, geo->dmin, geo->dmax,
+                         geo->periodic);
+    } else {
+        const int axis = r->pd.axis < 0 ? lub_par_longest_axis(S) : r->pd.axis;
+        /* the halo's width is the solver's (lubfoam_parallel_capacity) */
+        lub_par_init(&r->par, axis, 0.0, geo->dmin[axis], geo->dmax[axis], geo->periodic[axis]);
+    }
     r->par.interval = r->pd.interval;
     r->par.imbalance = r->pd.imbalance;
     r->par.margin = r->pd.margin;
@@ -113,24 +125,48 @@ void lubfoam_parallel_setup(lubfoam_run *r, const lubfoam_functions *fos)
     if (r->par.width != m->nb.rs + m->l0)
         lub_bug("the halo's width %.17g, the solver's lists %.17g + l0", r->par.width, m->nb.rs);
     const size_t total = r->par.ntotal;
-    char cuts[256] = "";
-    size_t len = 0;
-    for (int k = 1; k < size && len + 32 < sizeof cuts; k++)
-        len += (size_t)snprintf(cuts + len, sizeof cuts - len, "%s%.9g", k > 1 ? " " : "",
-                                r->par.cut[k]);
-    lub_message("Parallel: %d ranks, slabs along %c (%s), %zu particles, at most %zu per rank "
-                "(mean %.0f), halo width %g m%s%s",
-                size, "xyz"[axis],
-                r -> pd.axis<0 ? "auto: the fluid's longest" : "given", total, r->most,
-                             (double)total / size, r->par.width, size> 1
-                         ? ", cuts at "
-                         : "",
-                cuts);
-    /* what each rank holds: its slab, not the case (doc/parallel.md, per-rank capacity) */
+    /* what each rank holds: its slab or range, not the case (doc/parallel.md, per-rank
+     * capacity) */
     const double cap = lub_par_max((double)r->P.cap);
-    lub_message("Slabs: each rank's particles and solver sized for its slab, its halo and a "
-                "margin of %g: capacity at most %.0f particles per rank, %.1f%% of the case",
-                r->pd.margin, cap, total ? 100 * cap / (double)total : 0.0);
+    if (r->par.method == LUB_PAR_SFC) {
+        const lub_par *d = &r->par;
+        char cells[96];
+        snprintf(cells, sizeof cells, d->dim == 3 ? "%d x %d x %d" : "%d x %d", d->ncell[0],
+                 d->ncell[1], d->ncell[2]);
+        double h = d->csize[0];
+        for (int k = 1; k < d->dim; k++) h = fmin(h, d->csize[k]);
+        char axes[16] = "";
+        for (int j = 0; j < d->ncurve; j++)
+            snprintf(axes + strlen(axes), sizeof axes - strlen(axes), "%s%c", j ? ", " : "",
+                     "xyz"[d->curve[j]]);
+        lub_message("Parallel: %d ranks, sfc: ranges of a Hilbert curve over %s cells of at "
+                    "least %g m (the curve through %s%s), %zu particles, at most %zu per rank "
+                    "(mean %.0f), halo width %g m",
+                    size, cells, h, axes, d->ncurve < d->dim ? "; the cells across it one key" : "",
+                    total, r->most, (double)total / size, d->width);
+        lub_message("Ranges: each rank's particles and solver sized for its range of the curve, "
+                    "its halo and a margin of %g: capacity at most %.0f particles per rank, "
+                    "%.1f%% of the case",
+                    r->pd.margin, cap, total ? 100 * cap / (double)total : 0.0);
+    } else {
+        char cuts[256] = "";
+        size_t len = 0;
+        for (int k = 1; k < size && len + 32 < sizeof cuts; k++)
+            len += (size_t)snprintf(cuts + len, sizeof cuts - len, "%s%.9g", k > 1 ? " " : "",
+                                    r->par.cut[k]);
+        lub_message("Parallel: %d ranks, slabs along %c (%s), %zu particles, at most %zu per "
+                    "rank (mean %.0f), halo width %g m%s%s",
+                    size, "xyz"[axis],
+                    r -> pd.axis<0 ? "auto: the fluid's longest" : "given", total, r->most,
+                                 (double)total / size, r->par.width, size> 1
+                             ? ", cuts at "
+                             : "",
+                    cuts);
+        lub_message("Slabs: each rank's particles and solver sized for its slab, its halo and "
+                    "a margin of %g: capacity at most %.0f particles per rank, %.1f%% of the "
+                    "case",
+                    r->pd.margin, cap, total ? 100 * cap / (double)total : 0.0);
+    }
     /* the particle files: collective when the build's HDF5 is Open MPI's and the ids are
      * the rows (0 .. N-1, as particleGen numbers them), else gathered to rank 0 */
     const int dense = lub_par_ids_dense(&r->par, &r->P);

@@ -515,10 +515,11 @@ static int pair_checked(const moving_walls *mw, const long *count, int a, int b)
  *
  * On several ranks (f->par) each rank holds its slab's particles: it takes the pairs of its
  * own wall particles of a with the wall particles of b of every rank within reach (its own,
- * and the other ranks' within the paths' extent along the slabs' axis and 2 l0 of its slab:
- * lub_par_collect), the smallest distance at ts of each pair of patches over all ranks, and
- * the earliest meeting of all ranks with its rank's message: the serial check's pairs, each
- * on the rank of its a particle. */
+ * and the other ranks' within the paths' extent along the slabs' axis and 2 l0 of its slab,
+ * or with the curve's ranges within the paths' reach in space and 2 l0 of the box of its
+ * wall particles: lub_par_collect), the smallest distance at ts of each pair of patches over all
+ * ranks, and the earliest meeting of all ranks with its rank's message: the serial check's pairs,
+ * each on the rank of its a particle. */
 static void check_meeting(moving_walls *mw, const lub_mps *f, double ts, double te)
 {
     const lub_particles *P = f->P;
@@ -546,9 +547,18 @@ static void check_meeting(moving_walls *mw, const lub_mps *f, double ts, double 
             moves[a * np + b] =
                 pair_path(mw, a, b, ts, te, per, l0, &t, &nt, plo[a * np + b], phi[a * np + b]);
             free(t);
-            if (par && moves[a * np + b])
+            if (par && moves[a * np + b] && par->method == LUB_PAR_SFC) {
+                /* the curve's ranges are patches, not slabs: the paths' reach in space */
+                double r2 = 0;
+                for (int d = 0; d < dim; d++) {
+                    const double e = fmax(fabs(plo[a * np + b][d]), fabs(phi[a * np + b][d]));
+                    r2 += e * e;
+                }
+                reach = fmax(reach, sqrt(r2));
+            } else if (par && moves[a * np + b]) {
                 reach = fmax(reach, fmax(fabs(plo[a * np + b][par->axis]),
                                          fabs(phi[a * np + b][par->axis])));
+            }
         }
     /* the wall particles of each patch: this rank's (own), then on several ranks the other
      * ranks' within reach of its slab */
