@@ -65,13 +65,31 @@ static int fit(const lub_neighbours *nb, const lub_mps_mask *mask, unsigned mj, 
     return 1;
 }
 
+/* Row i's pair coefficients L_ij = scale w_ij c . p_ij of (LSMPS-L) into coef (0 for a
+ * neighbour outside mj or beyond re) */
+static void row(const lub_neighbours *nb, const lub_mps_mask *mask, unsigned mj, size_t i, int dim,
+                double il0, double scale, const double c[MT], double *coef)
+{
+    const int m = dim == 2 ? 5 : 9;
+    for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+        const double w = nb->w[q];
+        if (w <= 0 || !takes_part(mask, mj, nb->j[q])) {
+            coef[q] = 0.0;
+            continue;
+        }
+        double p[MT], cp = 0.0;
+        pair_basis(nb, q, dim, il0, p);
+        for (int a = 0; a < m; a++) cp += c[a] * p[a];
+        coef[q] = scale * w * cp;
+    }
+}
+
 size_t lub_mps_lsmps_laplacian(const lub_neighbours *nb, const lub_mps_mask *mask, int dim,
                                double l0, double rcond_min, double *coef, uint8_t *flag)
 {
     const size_t n = nb->n;
     const double il0 = 1.0 / l0, scale = 2.0 / (l0 * l0);
     const unsigned mi = mask ? mask->i : LUB_MPS_ALL, mj = mask ? mask->j : LUB_MPS_ALL;
-    const int m = dim == 2 ? 5 : 9;
     if (rcond_min <= 0) rcond_min = LUB_LSMPS_RCOND_MIN;
     size_t nflag = 0;
 #pragma omp parallel for schedule(static) reduction(+ : nflag)
@@ -83,17 +101,7 @@ size_t lub_mps_lsmps_laplacian(const lub_neighbours *nb, const lub_mps_mask *mas
             nflag++;
             continue;
         }
-        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
-            const double w = nb->w[q];
-            if (w <= 0 || !takes_part(mask, mj, nb->j[q])) {
-                coef[q] = 0.0;
-                continue;
-            }
-            double p[MT], cp = 0.0;
-            pair_basis(nb, q, dim, il0, p);
-            for (int a = 0; a < m; a++) cp += c[a] * p[a];
-            coef[q] = scale * w * cp;
-        }
+        row(nb, mask, mj, i, dim, il0, scale, c, coef);
         flag[i] = 0;
     }
     return nflag;
@@ -137,7 +145,6 @@ size_t lub_mps_lsmps_stabilized(const lub_neighbours *nb, const lub_mps_mask *ma
     /* S_ij = sc w_ij (T-3) */
     const double sc = 2.0 * dim / (o->lambda0 * o->n0), g0 = o->g0;
     const unsigned mi = mask ? mask->i : LUB_MPS_ALL, mj = mask ? mask->j : LUB_MPS_ALL;
-    const int m = dim == 2 ? 5 : 9;
     const double rcond_min = o->rcond_min > 0 ? o->rcond_min : LUB_LSMPS_RCOND_MIN;
     if (!(g0 > 0) || !(o->n0 > 0) || !(o->lambda0 > 0) || !(o->strength >= 0) || !(o->onset >= 1))
         lub_bug("stabilized LSMPS: g0 %g, n0 %g, lambda0 %g, strength %g, onset %g", g0, o->n0,
@@ -158,19 +165,11 @@ size_t lub_mps_lsmps_stabilized(const lub_neighbours *nb, const lub_mps_mask *ma
         /* the bias penalty: theta = 1 / (1 + lambda g), lambda g0 = strength (rho - onset) */
         const double rho = g / g0, over = rho - o->onset;
         double th = over > 0 ? 1.0 / (1.0 + o->strength * over * rho) : 1.0;
-        /* LSMPS's coefficients A_ij (in coef), and the positivity bound on theta */
+        /* LSMPS's coefficients A_ij (in coef), and the positivity bound on theta:
+         * theta A + (1 - theta) S >= 0 for A < 0: theta <= S / (S - A) */
+        row(nb, mask, mj, i, dim, il0, scale, c, coef);
         for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
-            const double w = nb->w[q];
-            if (w <= 0 || !takes_part(mask, mj, nb->j[q])) {
-                coef[q] = 0.0;
-                continue;
-            }
-            double p[MT], cp = 0.0;
-            pair_basis(nb, q, dim, il0, p);
-            for (int a = 0; a < m; a++) cp += c[a] * p[a];
-            coef[q] = scale * w * cp;
-            /* theta A + (1 - theta) S >= 0 for A < 0: theta <= S / (S - A) */
-            const double S = sc * w;
+            const double S = sc * nb->w[q];
             if (coef[q] < 0) th = fmin(th, S / (S - coef[q]));
         }
         /* (the max: the coefficient that bounds theta is zero but for round-off) */
