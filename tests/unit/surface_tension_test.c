@@ -858,7 +858,7 @@ static void test_bridge(void)
      * (they are h_s and more from the plates: no wall pairs; their neighbours' n^a and chi
      * take the plates' particles with the wall factor of 60 degrees) */
     double *wt = lub_calloc(P.n, sizeof(double)), *wx = lub_calloc(P.n, sizeof(double));
-    const double cw = 0.5 + 0.1 * (60 - 63.1) / (50.0 - 63.1); /* the model's table, 50-63.1 */
+    const double cw = 0.5 + 0.1 * (60 - 61.8) / (50.0 - 61.8); /* the model's table, 50-61.8 */
     pair_virial(&P, a, cw, 0.0, wt, wx);
     int nmid = 0;
     for (size_t i = 0; i < P.n; i++)
