@@ -230,9 +230,9 @@ static void st_read(lub_model *m, lub_scene *s)
             const lub_node *v = lub_dict_get(ca, name);
             lub_warning("%s:%d: surfaceTension: contactAngle %g degrees for '%s' is below %g "
                         "degrees, where the contact line of the measured drops creeps (30 "
-                        "degrees reached only after 0.2-0.3 s) and about 29 degrees is the "
-                        "smallest angle reached on the lattice wall whatever the wall factor: "
-                        "the angle is not a static one there (methods.md 9)",
+                        "degrees reached only after 0.2-0.3 s) and the drops of wall factor 0.85 "
+                        "and 0.933 stop at 28.6 degrees while the fully wetting one (1) still "
+                        "spreads: the angle is not a static one there (methods.md 9)",
                         lub_node_file(v), lub_node_line(v), S->theta[p], name, ANGLE_STATIC);
         }
     }
