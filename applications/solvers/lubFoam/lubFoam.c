@@ -339,16 +339,32 @@ static void write_cost(lubfoam_run *r, long steps, double wall, double pit_sum, 
                     "with the most (%.3f s on the least); halo %.1f%% of the owned particles "
                     "(mean over ranks and steps); %.0f particles on the fullest rank at the end "
                     "(mean %.0f); %.0f particles migrated; %ld re-balancing cuts; rank 0's "
-                    "phases:",
+                    "phases (the least and the most of any rank in brackets: the load's "
+                    "balance):",
                     r->par.size, us * r->par.size * omp_get_max_threads(),
                     ps > 0 ? 1e6 * cpu / ps : 0.0, cpu, comm, wall > 0 ? 100 * comm / wall : 0.0,
                     least, owned > 0 ? 100 * halo / owned : 0.0, most,
                     (double)r->par.ntotal / r->par.size, mig, r->par.nbalanced);
     }
+    /* each phase's spread over the ranks (collective: before the writer's return) */
+    double most_t[LUB_T_COUNT], least_t[LUB_T_COUNT];
+    for (int k = 0; k < LUB_T_COUNT; k++) {
+        most_t[k] = least_t[k] = phase_seconds(r, k);
+        if (r->parallel) {
+            most_t[k] = lub_par_max(most_t[k]);
+            least_t[k] = -lub_par_max(-least_t[k]);
+        }
+    }
     if (!lubfoam_writer_rank(r)) return;
-    for (int k = 0; k < LUB_T_COUNT; k++)
-        lub_message("  %-16s %10.3f s  %5.1f%%", lub_mps_phase_names[k], phase_seconds(r, k),
-                    wall > 0 ? 100 * phase_seconds(r, k) / wall : 0.0);
+    for (int k = 0; k < LUB_T_COUNT; k++) {
+        if (r->parallel && r->par.size > 1)
+            lub_message("  %-16s %10.3f s  %5.1f%%   [%.3f, %.3f s]", lub_mps_phase_names[k],
+                        phase_seconds(r, k), wall > 0 ? 100 * phase_seconds(r, k) / wall : 0.0,
+                        least_t[k], most_t[k]);
+        else
+            lub_message("  %-16s %10.3f s  %5.1f%%", lub_mps_phase_names[k], phase_seconds(r, k),
+                        wall > 0 ? 100 * phase_seconds(r, k) / wall : 0.0);
+    }
     char path[LUB_PATH_MAX];
     lub_postproc_path(&r->cs, "cost", r->start_name, "cost.dat", path);
     lub_atomic_file af;
