@@ -62,13 +62,17 @@
  * Every quadratic that satisfies the condition at x_b is still reproduced exactly (its
  * residual is zero at every row), whatever mu_i; one that violates it is not. */
 enum { LUB_LSMPS_BC_NEUMANN = 0, LUB_LSMPS_BC_DIRICHLET = 1 };
-/* Default weight of the boundary row (system/schemes.yaml laplacian.freeSurface.weight) */
-#define LUB_LSMPS_BC_WEIGHT 1.0
+/* Default weight of the boundary row (system/schemes.yaml laplacian.freeSurface.weight):
+ * chosen in tutorials/convergence/wedgeB at h0/8 (stress-free row, (1.2) in both terms;
+ * relative L2 3.6% at 1, 3.3% at 3, 2.6% at 10, 2.5% at 30, 2.2% at 100, 2.7% at 1000; at h0/4
+ * 7.5%, 7.0%, 6.8%, 6.7%, 7.0% at 1, 10, 30, 100, 1000).  Above about 3 the stabilized rows just
+ * below a plane surface are blended a little (theta >= 0.89, the positivity bound). */
+#define LUB_LSMPS_BC_WEIGHT 100.0
 typedef struct {
     int kind;           /* LUB_LSMPS_BC_* */
     const double *n[3]; /* n[d][i]: the boundary's outward unit normal seen from particle i */
     const double *d;    /* d[i]: the distance from x_i to the boundary along n_i (<= 0: no row) */
-    double weight;      /* the row's weight: mu_i = weight (sum_j w_ij) w(d_i, re) / 1 */
+    double weight;      /* the row's weight: mu_i = weight w(d_i, re) sum_j w_ij */
     double re_l0;       /* re / l0 (the kernel T-6 of the boundary point) */
     double *diag;       /* DIRICHLET: L_ib of each particle (0 where no row; NULL: not wanted) */
 } lub_lsmps_bc;

@@ -158,7 +158,6 @@ typedef struct {
     size_t nsurface, nunknowns, nfallback, nrebuild;
     size_t nlapfallback;            /* LSMPS Laplacian rows taken as standard (lsmps.h) */
     size_t nlapblend;               /* stabilized LSMPS rows blended with T-3 (theta < 1) */
-    size_t nlapsurface;             /* viscosity rows with the free surface's row in the fit */
     size_t nisolated;               /* particles of groups touching no Dirichlet particle, taken as
                                        surface particles (step.c, isolated_groups) */
     unsigned long long isolated_id; /* the id of the first of them */

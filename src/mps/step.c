@@ -449,8 +449,8 @@ static int open_side(const lub_mps *m, size_t i, const double c[3], double ccos)
  * viscous step at r^k the last step's (the "surface" field, which moves with the particles
  * when they are sorted), and where there is none (first step, or another freeSurface.test)
  * the geometric test of free_surface without its history: PND below beta n0 and an open
- * side of sectorAngle.  Returns the number of rows. */
-static size_t surface_rows(lub_mps *m, int for_pressure)
+ * side of sectorAngle. */
+static void surface_rows(lub_mps *m, int for_pressure)
 {
     const lub_particles *P = m->P;
     const lub_neighbours *nb = &m->nb;
@@ -476,8 +476,7 @@ static size_t surface_rows(lub_mps *m, int for_pressure)
             fs[i] = wsum < lim && open_side(m, i, c, m->c.cone_cos);
         }
     }
-    size_t nrows = 0;
-#pragma omp parallel for schedule(static) reduction(+ : nrows)
+#pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
         m->bcd[i] = 0.0;
         if (P->kind[i] != LUB_FLUID) continue;
@@ -499,9 +498,7 @@ static size_t surface_rows(lub_mps *m, int for_pressure)
             out = fmax(out, rn);
         }
         m->bcd[i] = 0.5 * m->l0 + out;
-        nrows++;
     }
-    return nrows;
 }
 
 static void lsmps_coefficients(lub_mps *m, int kind, const lub_lsmps_bc *bc)
@@ -717,7 +714,7 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
                                m->c.surf_weight,
                                m->re / m->l0,
                                NULL};
-            if (m->c.surf_viscosity) m->st.nlapsurface += surface_rows(m, 0);
+            if (m->c.surf_viscosity) surface_rows(m, 0);
             lsmps_coefficients(m, m->c.lap_viscosity, m->c.surf_viscosity ? &bc : NULL);
             const double h = 0.5 * dt * m->c.nu;
             lub_csr_begin(&m->A2, nf);
