@@ -65,6 +65,9 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->lsmps_rcond = LUB_LSMPS_RCOND_MIN;
     c->stab_strength = LUB_LSMPS_STAB_STRENGTH;
     c->stab_onset = LUB_LSMPS_STAB_ONSET;
+    c->surf_viscosity = 0;
+    c->surf_pressure = 0;
+    c->surf_weight = LUB_LSMPS_BC_WEIGHT;
     c->order_rows = 0;
     c->dummy_velocity = LUB_DUMMY_MIRROR;
     c->p_solver = lub_linsolver_defaults();
@@ -161,6 +164,12 @@ static void read_schemes(lub_mps_config *c, const char *path)
     lub_node *stab = lub_dict_map_or(ls, "stabilization");
     c->stab_strength = lub_dict_real_or(stab, "strength", c->stab_strength, LUB_BETWEEN(0.0, 1e6));
     c->stab_onset = lub_dict_real_or(stab, "onset", c->stab_onset, LUB_BETWEEN(1.0, 1e6));
+    lub_node *lfs = lub_dict_map_or(ls, "freeSurface");
+    static const char *const vbc[] = {"none", "stressFree", NULL};
+    static const char *const pbc[] = {"none", "surfacePoint", NULL};
+    c->surf_viscosity = lub_dict_choice(lfs, "viscosity", vbc, c->surf_viscosity);
+    c->surf_pressure = lub_dict_choice(lfs, "pressure", pbc, c->surf_pressure);
+    c->surf_weight = lub_dict_real_or(lfs, "weight", c->surf_weight, LUB_BETWEEN(1e-6, 1e6));
     static const char *const order[] = {"cells", "rows", NULL};
     c->order_rows = lub_dict_choice(r, "particleOrder", order, c->order_rows);
     c->reorder_interval =

@@ -38,12 +38,34 @@ static inline void pair_basis(const lub_neighbours *nb, size_t q, int dim, doubl
     basis(dim, s, p);
 }
 
-/* c = M_i^-1 e of (LSMPS-L) for particle i from its neighbours of the kinds mj; returns 0
- * (c untouched) where M_i is ill-conditioned (pivot ratio below rcond_min) */
-static int fit(const lub_neighbours *nb, const lub_mps_mask *mask, unsigned mj, size_t i, int dim,
-               double il0, double rcond_min, double c[MT])
+/* r_i of a boundary row (lsmps.h) at s_b = delta n: p(s_b) (Dirichlet) or its derivative
+ * along n (Neumann) */
+static void bc_row(int dim, int kind, const double n[3], double delta, double r[MT])
 {
-    double M[MT][MT];
+    const double s[3] = {delta * n[0], delta * n[1], dim == 3 ? delta * n[2] : 0.0};
+    if (kind == LUB_LSMPS_BC_DIRICHLET) {
+        basis(dim, s, r);
+        return;
+    }
+    if (dim == 2) {
+        r[0] = n[0], r[1] = n[1];
+        r[2] = 2 * s[0] * n[0], r[3] = 2 * s[1] * n[1], r[4] = s[0] * n[1] + s[1] * n[0];
+        return;
+    }
+    r[0] = n[0], r[1] = n[1], r[2] = n[2];
+    r[3] = 2 * s[0] * n[0], r[4] = 2 * s[1] * n[1], r[5] = 2 * s[2] * n[2];
+    r[6] = s[0] * n[1] + s[1] * n[0], r[7] = s[0] * n[2] + s[2] * n[0];
+    r[8] = s[1] * n[2] + s[2] * n[1];
+}
+
+/* c = M_i^-1 e of (LSMPS-L) for particle i from its neighbours of the kinds mj, with the
+ * boundary row of bc where bc->d[i] > 0 (M'_i = M_i + mu r r^T; *mu_r = mu c . r, the
+ * Dirichlet value's coefficient over 2/l0^2, else 0); returns 0 (c untouched) where M_i is
+ * ill-conditioned (pivot ratio below rcond_min) */
+static int fit(const lub_neighbours *nb, const lub_mps_mask *mask, unsigned mj, size_t i, int dim,
+               double il0, double rcond_min, const lub_lsmps_bc *bc, double c[MT], double *mu_r)
+{
+    double M[MT][MT], wsum = 0;
     const int m = dim == 2 ? 5 : 9;
     for (int a = 0; a < m; a++)
         for (int b = 0; b < m; b++) M[a][b] = 0.0;
@@ -52,8 +74,21 @@ static int fit(const lub_neighbours *nb, const lub_mps_mask *mask, unsigned mj, 
         if (w <= 0 || !takes_part(mask, mj, nb->j[q])) continue;
         double p[MT];
         pair_basis(nb, q, dim, il0, p);
+        wsum += w;
         for (int a = 0; a < m; a++)
             for (int b = 0; b <= a; b++) M[a][b] += w * p[a] * p[b];
+    }
+    double r[MT] = {0}, mu = 0;
+    *mu_r = 0.0;
+    if (bc && bc->d[i] > 0 && wsum > 0) {
+        const double n[3] = {bc->n[0][i], bc->n[1][i], dim == 3 ? bc->n[2][i] : 0.0};
+        bc_row(dim, bc->kind, n, bc->d[i] * il0, r);
+        /* the kernel's weight of the boundary point, as a neighbour's: the condition
+         * binds where the surface cuts the neighbourhood, fades as it leaves it */
+        const double rr = bc->d[i] * il0 / bc->re_l0;
+        mu = rr < 1 ? bc->weight * wsum * (1 - rr) * (1 - rr) : 0.0;
+        for (int a = 0; a < m; a++)
+            for (int b = 0; b <= a; b++) M[a][b] += mu * r[a] * r[b];
     }
     for (int a = 0; a < m; a++)
         for (int b = a + 1; b < m; b++) M[a][b] = M[b][a];
@@ -62,6 +97,11 @@ static int fit(const lub_neighbours *nb, const lub_mps_mask *mask, unsigned mj, 
     double e[MT] = {0};
     for (int a = dim; a < 2 * dim; a++) e[a] = 1.0;
     lub_lsq_solve(&F, e, c);
+    if (mu > 0 && bc->kind == LUB_LSMPS_BC_DIRICHLET) {
+        double cr = 0;
+        for (int a = 0; a < m; a++) cr += c[a] * r[a];
+        *mu_r = mu * cr;
+    }
     return 1;
 }
 
@@ -85,7 +125,8 @@ static void row(const lub_neighbours *nb, const lub_mps_mask *mask, unsigned mj,
 }
 
 size_t lub_mps_lsmps_laplacian(const lub_neighbours *nb, const lub_mps_mask *mask, int dim,
-                               double l0, double rcond_min, double *coef, uint8_t *flag)
+                               double l0, double rcond_min, const lub_lsmps_bc *bc, double *coef,
+                               uint8_t *flag)
 {
     const size_t n = nb->n;
     const double il0 = 1.0 / l0, scale = 2.0 / (l0 * l0);
@@ -95,13 +136,15 @@ size_t lub_mps_lsmps_laplacian(const lub_neighbours *nb, const lub_mps_mask *mas
 #pragma omp parallel for schedule(static) reduction(+ : nflag)
     for (size_t i = 0; i < n; i++) {
         if (!takes_part(mask, mi, i)) continue;
-        double c[MT];
-        if (!fit(nb, mask, mj, i, dim, il0, rcond_min, c)) {
+        double c[MT], mu_r;
+        if (!fit(nb, mask, mj, i, dim, il0, rcond_min, bc, c, &mu_r)) {
             flag[i] = 1;
+            if (bc && bc->diag) bc->diag[i] = 0.0;
             nflag++;
             continue;
         }
         row(nb, mask, mj, i, dim, il0, scale, c, coef);
+        if (bc && bc->diag) bc->diag[i] = scale * mu_r;
         flag[i] = 0;
     }
     return nflag;
@@ -153,10 +196,11 @@ size_t lub_mps_lsmps_stabilized(const lub_neighbours *nb, const lub_mps_mask *ma
 #pragma omp parallel for schedule(static) reduction(+ : nflag)
     for (size_t i = 0; i < n; i++) {
         if (!takes_part(mask, mi, i)) continue;
-        double c[MT];
-        if (!fit(nb, mask, mj, i, dim, il0, rcond_min, c)) {
+        double c[MT], mu_r;
+        if (!fit(nb, mask, mj, i, dim, il0, rcond_min, o->bc, c, &mu_r)) {
             flag[i] = 1;
             if (theta) theta[i] = 0.0;
+            if (o->bc && o->bc->diag) o->bc->diag[i] = 0.0;
             nflag++;
             continue;
         }
@@ -177,6 +221,7 @@ size_t lub_mps_lsmps_stabilized(const lub_neighbours *nb, const lub_mps_mask *ma
             if (nb->w[q] > 0 && takes_part(mask, mj, nb->j[q]))
                 coef[q] = fmax(0.0, th * coef[q] + (1.0 - th) * sc * nb->w[q]);
         if (theta) theta[i] = th;
+        if (o->bc && o->bc->diag) o->bc->diag[i] = th * scale * mu_r;
         flag[i] = 0;
     }
     return nflag;

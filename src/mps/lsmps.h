@@ -39,14 +39,54 @@
 /* Default smallest pivot ratio of M_i (in l0 units) accepted. */
 #define LUB_LSMPS_RCOND_MIN 1e-3
 
+/* A boundary condition inside the fit (methods.md §1, (1.3); derived: Matsunaga and Koshizuka
+ * put the boundary conditions into the least-squares objective, lubkit's sources do not print
+ * how).  Where d_i > 0 the objective of particle i gets one more row, at the boundary point
+ * x_b = x_i + d_i n_i (s_b = d_i n_i / l0),
+ *
+ *     J_i(a) = sum_j w_ij (f_j - f_i - a . p_ij)^2 + mu_i (t_i - r_i . a)^2,
+ *     mu_i = weight w(d_i, re) sum_j w_ij   (w of T-6: the row fades as the surface leaves
+ *                                           the neighbourhood),
+ *
+ *   NEUMANN    n . grad f(x_b) = 0:  r_i = n_i . grad_s p(s_b),  t_i = 0 (the stress-free
+ *              surface for the velocity, to leading order du/dn = 0);
+ *   DIRICHLET  f(x_b) = 0:           r_i = p(s_b),               t_i = 0 - f_i (the free
+ *              surface for the pressure, P = 0 on it),
+ *
+ * whose minimiser is a_i = M'_i^-1 (sum_j w_ij p_ij (f_j - f_i) + mu_i r_i t_i), M'_i = M_i +
+ * mu_i r_i r_i^T: the pair coefficients are those of (LSMPS-L) with M'_i for M_i, and a
+ * Dirichlet row adds the coefficient of the boundary value, L_ib = (2/l0^2) mu_i c'_i . r_i,
+ *
+ *     lap f_i = sum_j L_ij (f_j - f_i) + L_ib (0 - f_i),   c'_i = M'_i^-1 e.
+ *
+ * Every quadratic that satisfies the condition at x_b is still reproduced exactly (its
+ * residual is zero at every row), whatever mu_i; one that violates it is not. */
+enum { LUB_LSMPS_BC_NEUMANN = 0, LUB_LSMPS_BC_DIRICHLET = 1 };
+/* Default weight of the boundary row (system/schemes.yaml laplacian.freeSurface.weight):
+ * chosen in tutorials/convergence/wedgeB at h0/8 (stress-free row, (1.2) in both terms;
+ * relative L2 3.6% at 1, 3.3% at 3, 2.6% at 10, 2.5% at 30, 2.2% at 100, 2.7% at 1000; at h0/4
+ * 7.5%, 7.0%, 6.8%, 6.7%, 7.0% at 1, 10, 30, 100, 1000).  Above about 3 the stabilized rows just
+ * below a plane surface are blended a little (theta >= 0.89, the positivity bound). */
+#define LUB_LSMPS_BC_WEIGHT 100.0
+typedef struct {
+    int kind;           /* LUB_LSMPS_BC_* */
+    const double *n[3]; /* n[d][i]: the boundary's outward unit normal seen from particle i */
+    const double *d;    /* d[i]: the distance from x_i to the boundary along n_i (<= 0: no row) */
+    double weight;      /* the row's weight: mu_i = weight w(d_i, re) sum_j w_ij */
+    double re_l0;       /* re / l0 (the kernel T-6 of the boundary point) */
+    double *diag;       /* DIRICHLET: L_ib of each particle (0 where no row; NULL: not wanted) */
+} lub_lsmps_bc;
+
 /* The coefficients L_ij of (LSMPS-L) for the particles i of mask->i, from their neighbours j
  * of mask->j within re (w_ij > 0): coef[q] for each entry q of i's list (0 for a neighbour
  * outside mask->j).  flag[i] = 1 where M_i is ill-conditioned (its coefficients are left
  * untouched: the caller takes the standard Laplacian), else 0; particles outside mask->i are
- * not touched.  rcond_min <= 0 selects LUB_LSMPS_RCOND_MIN.  Returns the number flagged.
+ * not touched.  rcond_min <= 0 selects LUB_LSMPS_RCOND_MIN.  bc (may be NULL): a boundary
+ * row in the fits of the particles with bc->d[i] > 0.  Returns the number flagged.
  * coef has the lists' capacity (nb->cap_pairs entries). */
 size_t lub_mps_lsmps_laplacian(const lub_neighbours *nb, const lub_mps_mask *mask, int dim,
-                               double l0, double rcond_min, double *coef, uint8_t *flag);
+                               double l0, double rcond_min, const lub_lsmps_bc *bc, double *coef,
+                               uint8_t *flag);
 
 /* Stabilized LSMPS (methods.md §1, (1.2); after Matsunaga and Koshizuka, CMAME 389 (2022)
  * 114416, whose stabilisation terms are not printed in lubkit's sources: this is a design
@@ -83,11 +123,13 @@ size_t lub_mps_lsmps_laplacian(const lub_neighbours *nb, const lub_mps_mask *mas
  * Where the pivot ratio of M_i is below rcond_min, g_i is taken as infinite: theta = 0 and
  * the particle is flagged (the caller's standard row, as lub_mps_lsmps_laplacian). */
 typedef struct {
-    double n0, lambda0; /* T-5, T-4 of the particles' level: S_ij = 2d w_ij / (lambda0 n0) */
-    double g0;          /* e . M^-1 e on the full lattice (lub_mps_lsmps_reference) */
-    double strength;    /* the bias penalty's slope (>= 0; 0: only the positivity bound) */
-    double onset;       /* g_i/g0 up to which the bias penalty is zero (>= 1) */
-    double rcond_min;   /* as lub_mps_lsmps_laplacian (<= 0: LUB_LSMPS_RCOND_MIN) */
+    double n0, lambda0;     /* T-5, T-4 of the particles' level: S_ij = 2d w_ij / (lambda0 n0) */
+    double g0;              /* e . M^-1 e on the full lattice (lub_mps_lsmps_reference) */
+    double strength;        /* the bias penalty's slope (>= 0; 0: only the positivity bound) */
+    double onset;           /* g_i/g0 up to which the bias penalty is zero (>= 1) */
+    double rcond_min;       /* as lub_mps_lsmps_laplacian (<= 0: LUB_LSMPS_RCOND_MIN) */
+    const lub_lsmps_bc *bc; /* as lub_mps_lsmps_laplacian (NULL: none): M'_i for M_i in
+                               A_ij and g_i; bc->diag gets theta_i L_ib */
 } lub_lsmps_stabilization;
 
 /* Defaults of strength and onset (system/schemes.yaml laplacian.stabilization): onset 3, not

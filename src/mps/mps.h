@@ -99,6 +99,9 @@ typedef struct {
     double lsmps_rcond;     /* LSMPS Laplacian: smallest pivot ratio of M_i (mps/lsmps.h) */
     double stab_strength;   /* stabilized LSMPS: the bias penalty's strength and onset */
     double stab_onset;      /* (lub_lsmps_stabilization, mps/lsmps.h) */
+    int surf_viscosity;     /* fitted viscosity: the stress-free row at the free surface (1) */
+    int surf_pressure;      /* fitted pressure: the surface point P = 0 in the fit (1) */
+    double surf_weight;     /* their weight (lub_lsmps_bc.weight) */
     int reorder_interval;   /* steps between sorts of the particles (0: never) */
     int order_rows;         /* the sort: 0 cell order, 1 lattice rows of l0 */
     int dummy_velocity;     /* LUB_DUMMY_*: the dummies' velocity in the viscous term (step.c,
@@ -218,6 +221,12 @@ struct lub_mps {
     double *lapc;
     size_t lapc_cap;
     uint8_t *lapflag;
+    /* the free surface's row in the fits (laplacian.freeSurface, methods.md (1.3)): the
+     * outward normal, the distance to the surface (0: no row) and the Dirichlet row's
+     * coefficient L_ib of each particle, the surface flags they were formed from; NULL
+     * unless configured */
+    double *bcn[3], *bcd, *bcdiag;
+    uint8_t *bcs;
     double lsmps_g0; /* stabilized LSMPS: g0 of the level (lub_mps_lsmps_reference) */
     lub_csr A2;
     lub_bicgstab_work bw;

@@ -110,6 +110,13 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
     m->surface = lub_calloc(n ? n : 1, 1);
     m->anchor = lub_calloc(n ? n : 1, 1);
     m->lapflag = lub_calloc(n ? n : 1, 1);
+    if ((c->surf_viscosity && LUB_LAPLACIAN_FITTED(c->lap_viscosity)) ||
+        (c->surf_pressure && LUB_LAPLACIAN_FITTED(c->lap_pressure))) {
+        for (int d = 0; d < 3; d++) m->bcn[d] = alloc_doubles(n);
+        m->bcd = alloc_doubles(n);
+        m->bcdiag = alloc_doubles(n);
+        m->bcs = lub_calloc(n ? n : 1, 1);
+    }
     m->lsmps_g0 = lub_mps_lsmps_reference(m->dim, m->l0, m->re);
     {
         const int h = (int)ceil(m->re / m->l0), hz = m->dim == 3 ? h : 0;
@@ -161,6 +168,10 @@ void lub_mps_free(lub_mps *m)
     lub_bicgstab_work_free(&m->bw);
     free(m->lapc);
     free(m->lapflag);
+    for (int d = 0; d < 3; d++) free(m->bcn[d]);
+    free(m->bcd);
+    free(m->bcdiag);
+    free(m->bcs);
     lub_linsolver_free(&m->psolver);
     lub_linsolver_free(&m->vsolver);
 }
@@ -248,6 +259,10 @@ void lub_mps_resize(lub_mps *m, size_t cap)
     m->surface = regrow(m->surface, old, cap, 1);
     m->anchor = regrow(m->anchor, old, cap, 1);
     m->lapflag = regrow(m->lapflag, old, cap, 1);
+    for (int d = 0; d < 3; d++) m->bcn[d] = regrow(m->bcn[d], old, cap, sizeof(double));
+    m->bcd = regrow(m->bcd, old, cap, sizeof(double));
+    m->bcdiag = regrow(m->bcdiag, old, cap, sizeof(double));
+    m->bcs = regrow(m->bcs, old, cap, 1);
     m->row = regrow(m->row, old, cap, sizeof *m->row);
     m->prow = regrow(m->prow, old, cap, sizeof *m->prow);
     m->scratch = regrow(m->scratch, old, cap, sizeof(double));
@@ -421,7 +436,72 @@ static void smooth_fluid(lub_mps *m, double *const f[3], double *const out[3])
  * row.  The nonsymmetric system is solved by BiCGStab, preconditioned by the solver of the
  * standard matrix of the same particles (its AMG, IC(0), Jacobi or CHOLMOD factor), which
  * lies spectrally close to it. */
-static void lsmps_coefficients(lub_mps *m, int kind)
+static int open_side(const lub_mps *m, size_t i, const double c[3], double ccos);
+
+/* The free surface's rows in the fits (laplacian.freeSurface; methods.md §1, (1.3)).  A fluid
+ * particle gets one where it is a surface particle or has one among its fluid neighbours: its
+ * neighbourhood is cut by the surface.  The outward normal n_i = -c_i / |c_i|, c_i = sum_j
+ * w_ij r_ij over all its neighbours, walls and dummies included (the direction in which the
+ * PND falls: away from a wall beside the surface too); the distance to the surface d_i = l0/2
+ * + max(0, max_{j surface} r_ij . n_i): the surface lies half a spacing beyond the outermost
+ * particles (T-12's surface particles), as the particles' volumes end there.  d_i = 0 (no
+ * row) elsewhere.  The surface flags: the pressure's (m->surface, fresh, at r*), or for the
+ * viscous step at r^k the last step's (the "surface" field, which moves with the particles
+ * when they are sorted), and where there is none (first step, or another freeSurface.test)
+ * the geometric test of free_surface without its history: PND below beta n0 and an open
+ * side of sectorAngle. */
+static void surface_rows(lub_mps *m, int for_pressure)
+{
+    const lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    const size_t n = P->n;
+    const int dim = m->dim;
+    uint8_t *fs = m->bcs;
+    if (for_pressure) {
+        memcpy(fs, m->surface, n);
+    } else if (m->surf && !m->surf_fresh) {
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++) fs[i] = P->kind[i] == LUB_FLUID && m->surf[i] > 0;
+    } else {
+        const double lim = m->c.beta * m->n0;
+#pragma omp parallel for schedule(static)
+        for (size_t i = 0; i < n; i++) {
+            fs[i] = 0;
+            if (P->kind[i] != LUB_FLUID) continue;
+            double c[3] = {0, 0, 0}, wsum = 0;
+            for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+                wsum += nb->w[q];
+                for (int d = 0; d < dim; d++) c[d] += nb->w[q] * nb->dx[d][q];
+            }
+            fs[i] = wsum < lim && open_side(m, i, c, m->c.cone_cos);
+        }
+    }
+#pragma omp parallel for schedule(static)
+    for (size_t i = 0; i < n; i++) {
+        m->bcd[i] = 0.0;
+        if (P->kind[i] != LUB_FLUID) continue;
+        int cut = fs[i];
+        double c[3] = {0, 0, 0};
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+            if (nb->w[q] <= 0) continue;
+            cut |= fs[nb->j[q]];
+            for (int d = 0; d < dim; d++) c[d] += nb->w[q] * nb->dx[d][q];
+        }
+        const double cn = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
+        if (!cut || !(cn > 0)) continue;
+        double out = 0;
+        for (int d = 0; d < 3; d++) m->bcn[d][i] = -c[d] / cn;
+        for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+            if (nb->w[q] <= 0 || !fs[nb->j[q]]) continue;
+            double rn = 0;
+            for (int d = 0; d < dim; d++) rn += nb->dx[d][q] * m->bcn[d][i];
+            out = fmax(out, rn);
+        }
+        m->bcd[i] = 0.5 * m->l0 + out;
+    }
+}
+
+static void lsmps_coefficients(lub_mps *m, int kind, const lub_lsmps_bc *bc)
 {
     const lub_particles *P = m->P;
     if (m->lapc_cap < m->nb.cap_pairs) { /* the lists grew (rare after the first steps) */
@@ -434,7 +514,8 @@ static void lsmps_coefficients(lub_mps *m, int kind)
         /* (1.2): the blend with T-3 takes care of the surface and of the sign; the rows whose
          * M_i is singular are flagged (the standard row, as below) */
         const lub_lsmps_stabilization o = {
-            m->n0, m->lambda0, m->lsmps_g0, m->c.stab_strength, m->c.stab_onset, m->c.lsmps_rcond};
+            m->n0,           m->lambda0,       m->lsmps_g0, m->c.stab_strength,
+            m->c.stab_onset, m->c.lsmps_rcond, bc};
         m->st.nlapfallback +=
             lub_mps_lsmps_stabilized(&m->nb, &lm, m->dim, m->l0, &o, m->lapc, m->lapflag, m->lap);
         size_t nblend = 0;
@@ -444,7 +525,7 @@ static void lsmps_coefficients(lub_mps *m, int kind)
         m->st.nlapblend += nblend;
         return;
     }
-    lub_mps_lsmps_laplacian(&m->nb, &lm, m->dim, m->l0, m->c.lsmps_rcond, m->lapc, m->lapflag);
+    lub_mps_lsmps_laplacian(&m->nb, &lm, m->dim, m->l0, m->c.lsmps_rcond, bc, m->lapc, m->lapflag);
     /* near a free surface (PND of all neighbours, dummies included, below beta n0) the fit
      * extrapolates from a one-sided neighbourhood: its second derivatives are poor and the
      * operator can lose the sign of a diffusion (it blew up within 15 steps at the outlet of
@@ -463,7 +544,9 @@ static void lsmps_coefficients(lub_mps *m, int kind)
                 wsum += nb->w[q];
                 if (nb->w[q] > 0 && P->kind[nb->j[q]] != LUB_DUMMY) asum += m->lapc[q];
             }
-            if (wsum < lim || !(asum > 0)) m->lapflag[i] = 1;
+            /* a row with the surface's condition in its fit is no extrapolation */
+            const int bcrow = bc && bc->d[i] > 0;
+            if ((wsum < lim && !bcrow) || !(asum > 0)) m->lapflag[i] = 1;
         }
         nflag += m->lapflag[i];
     }
@@ -625,7 +708,14 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
             /* (T-31) with the LSMPS Laplacian: u*_i - h sum_j L_ij (u*_j - u*_i) = u_i +
              * h sum_j L_ij (u_j - u_i) + dt (g - G/rho), h = dt nu / 2, the wall particles'
              * velocities known; the rows of flagged particles keep T-3's (above) */
-            lsmps_coefficients(m, m->c.lap_viscosity);
+            lub_lsmps_bc bc = {LUB_LSMPS_BC_NEUMANN,
+                               {m->bcn[0], m->bcn[1], m->bcn[2]},
+                               m->bcd,
+                               m->c.surf_weight,
+                               m->re / m->l0,
+                               NULL};
+            if (m->c.surf_viscosity) surface_rows(m, 0);
+            lsmps_coefficients(m, m->c.lap_viscosity, m->c.surf_viscosity ? &bc : NULL);
             const double h = 0.5 * dt * m->c.nu;
             lub_csr_begin(&m->A2, nf);
             for (int r = 0; r < nf; r++)
@@ -1159,7 +1249,14 @@ assemble:
         /* the LSMPS Laplacian in the fluid rows: sum_j L_ij (P_i - P_j) + alpha P_i = b_i, the
          * Dirichlet neighbours' given pressures moved to b; the wall particles' rows (and the
          * flagged fluid rows) stay those of T-10 above, which A keeps for the preconditioner */
-        lsmps_coefficients(m, m->c.lap_pressure);
+        lub_lsmps_bc bc = {LUB_LSMPS_BC_DIRICHLET,
+                           {m->bcn[0], m->bcn[1], m->bcn[2]},
+                           m->bcd,
+                           m->c.surf_weight,
+                           m->re / m->l0,
+                           m->bcdiag};
+        if (m->c.surf_pressure) surface_rows(m, 1);
+        lsmps_coefficients(m, m->c.lap_pressure, m->c.surf_pressure ? &bc : NULL);
         lub_csr_begin(&m->A2, nu);
         for (int r = 0; r < nu; r++)
             lub_csr_set_row_length(&m->A2, r, lub_csr_row_length(&m->A, r));
@@ -1189,6 +1286,8 @@ assemble:
                     bfix += a * P->p[j];
                 }
             }
+            /* the surface point's P = 0 in the fit (1.3): L_ib (0 - P_i) */
+            if (m->c.surf_pressure) asum += m->bcdiag[i];
             col[e] = r;
             val[e++] = asum + alpha;
             if (e != len) lub_bug("LSMPS pressure row %d: %d entries, expected %d", r, e, len);

@@ -304,7 +304,7 @@ static void test_biased(void)
                *q = malloc(c.n * sizeof *q);
         uint8_t *fs = calloc(c.n, 1), *fl = calloc(c.n, 1);
         lub_mps_lsmps_stabilized(&nb, &mk, 2, l0, &o, cs, fs, th);
-        lub_mps_lsmps_laplacian(&nb, &mk, 2, l0, 0.0, cl, fl);
+        lub_mps_lsmps_laplacian(&nb, &mk, 2, l0, 0.0, NULL, cl, fl);
         for (size_t i = 0; i < c.n; i++) {
             const double x = c.x[0][i], y = c.x[1][i];
             f[i] = smooth(x, y);
@@ -492,7 +492,7 @@ static double poisson(double l0, int op, size_t *nblend)
     if (op == 1) {
         CHECK(lub_mps_lsmps_stabilized(&nb, &mk, 2, l0, &o, coef, flag, th) == 0);
     } else if (op == 2) {
-        lub_mps_lsmps_laplacian(&nb, &mk, 2, l0, 0.0, coef, flag);
+        lub_mps_lsmps_laplacian(&nb, &mk, 2, l0, 0.0, NULL, coef, flag);
         for (size_t i = 0; i < c.n; i++) {
             if (c.kind[i]) continue;
             double ws = 0, as = 0;
@@ -587,6 +587,425 @@ static void test_poisson(void)
     for (int k = 0; k < 3; k++) CHECK(e[1][k] < e[0][k] && e[1][k] < e[2][k]);
 }
 
+/* The free surface's condition inside the fit (lsmps.h, lub_lsmps_bc; methods.md §1, (1.3)).
+ * The half-plane of test_biased (fluid y <= 0 jittered by 0.15 l0, its top row the surface
+ * particles), its surface h = l0/2 above the top row: the particles within re + l0/2 of it
+ * (the surface particles and their neighbours, as step.c picks them) get the stress-free row
+ * n . grad f(x_b) = 0, n = (0, 1), d = h - y_i.  bc_half_plane fills n and d. */
+static void bc_half_plane(const cloud *c, double l0, double re, double *n[3], double *d)
+{
+    const double h = 0.5 * l0;
+    for (size_t i = 0; i < c->n; i++) {
+        n[0][i] = 0, n[1][i] = 1, n[2][i] = 0;
+        d[i] = c->kind[i] == 0 && h - c->x[1][i] < re + 0.5 * l0 ? h - c->x[1][i] : 0.0;
+    }
+}
+
+/* smooth fields with du/dy = 0 at y = h (the surface) and their Laplacians */
+static double sfree(double x, double y, double h)
+{
+    return sin(2 * x) * cos(3 * (y - h)) + x * x * (y - h) * (y - h);
+}
+static double sfree_lap(double x, double y, double h)
+{
+    return -13 * sin(2 * x) * cos(3 * (y - h)) + 2 * (y - h) * (y - h) + 2 * x * x;
+}
+
+/* In the rows cut by the surface (the particles with a surface row): (a) a quadratic that
+ * satisfies the condition, u = 1.5 x^2 - 0.8 x + 2 (y - h)^2 + 0.3 (lap 7), is reproduced to
+ * round-off by the stabilized Laplacian with the row, at every such row (theta = 1: the row
+ * fixes the fit that the one-sided neighbourhood leaves loose), where without it the blend
+ * with T-3 misses it (the test fails without the row); (b) one that violates it, u + 0.9 (y -
+ * h) + 0.5 x (y - h) (the same lap 7), is not (the row is in the fit: the test fails for the
+ * operator without it, which reproduces both); (c) the minimiser of the objective with the row,
+ * solved here directly, gives the same Laplacian as the pair coefficients; (d) a smooth field
+ * with du/dn = 0 at the surface: the error of the surface rows with the row against without. */
+static void check_surface_rows(double weight)
+{
+    const double l0 = 0.1, re = 3.1 * l0, h = 0.5 * l0;
+    rng_state = 88172645463325252ull;
+    cloud c;
+    biased(&c, 0);
+    lub_neighbours nb;
+    build_open(&nb, &c, 2, re);
+    double *n[3], *d = malloc(c.n * sizeof *d);
+    for (int k = 0; k < 3; k++) n[k] = malloc(c.n * sizeof *n[k]);
+    bc_half_plane(&c, l0, re, n, d);
+    const lub_lsmps_bc bc = {LUB_LSMPS_BC_NEUMANN, {n[0], n[1], n[2]}, d, weight, re / l0, NULL};
+    lub_lsmps_stabilization o = options(2, l0, re), ob = o;
+    ob.bc = &bc;
+    lub_mps_mask mk = {c.kind, LUB_MPS_KIND(0), LUB_MPS_KIND(0) | LUB_MPS_KIND(1)};
+    double *cb = malloc(nb.npairs * sizeof *cb), *c0 = malloc(nb.npairs * sizeof *c0),
+           *cl = malloc(nb.npairs * sizeof *cl), *cl0 = malloc(nb.npairs * sizeof *cl0),
+           *tb = malloc(c.n * sizeof *tb), *t0 = malloc(c.n * sizeof *t0);
+    double *qa = malloc(c.n * sizeof *qa), *qb = malloc(c.n * sizeof *qb),
+           *fs = malloc(c.n * sizeof *fs);
+    uint8_t *gb = calloc(c.n, 1), *g0 = calloc(c.n, 1), *gl = calloc(c.n, 1), *gl0 = calloc(c.n, 1);
+    lub_mps_lsmps_stabilized(&nb, &mk, 2, l0, &ob, cb, gb, tb);
+    lub_mps_lsmps_stabilized(&nb, &mk, 2, l0, &o, c0, g0, t0);
+    lub_mps_lsmps_laplacian(&nb, &mk, 2, l0, 0.0, &bc, cl, gl);
+    lub_mps_lsmps_laplacian(&nb, &mk, 2, l0, 0.0, NULL, cl0, gl0);
+    for (size_t i = 0; i < c.n; i++) {
+        const double x = c.x[0][i], y = c.x[1][i];
+        qa[i] = 1.5 * x * x - 0.8 * x + 2 * (y - h) * (y - h) + 0.3;
+        qb[i] = qa[i] + 0.9 * (y - h) + 0.5 * x * (y - h);
+        fs[i] = sfree(x, y, h);
+    }
+    const double cstd = lub_mps_laplacian_coefficient(2, o.lambda0, o.n0, 1.0);
+    size_t nrows = 0, nflag = 0, nexact0 = 0, nneg = 0, nneg0 = 0;
+    double ea = 0, ea0 = 0, ela = 0, eb = 0, ebl0 = 0, thmin = 1, dmax = 0, dscale = 0;
+    double sb = 0, s0 = 0, sl = 0, sl0 = 0, sstd = 0, sr = 0;
+    for (size_t i = 0; i < c.n; i++) {
+        if (!looked_at(&c, 0, i) || !(d[i] > 0)) continue;
+        nrows++;
+        if (gb[i] || gl[i] || gl0[i]) {
+            nflag++;
+            continue;
+        }
+        thmin = fmin(thmin, tb[i]);
+        ea = fmax(ea, fabs(apply_row(&nb, cb, qa, i) - 7));
+        ela = fmax(ela, fabs(apply_row(&nb, cl, qa, i) - 7));
+        eb = fmax(eb, fabs(apply_row(&nb, cb, qb, i) - 7));
+        const double e0 = g0[i] ? INFINITY : fabs(apply_row(&nb, c0, qa, i) - 7);
+        ea0 = fmax(ea0, e0);
+        nexact0 += e0 < 1e-9 * 7;
+        ebl0 = fmax(ebl0, fabs(apply_row(&nb, cl0, qb, i) - 7));
+        /* the sign of LSMPS's rows with the row and without */
+        int neg = 0, neg0 = 0;
+        for (size_t k = nb.start[i]; k < nb.end[i]; k++)
+            if (nb.w[k] > 0) neg |= cl[k] < 0, neg0 |= cl0[k] < 0;
+        nneg += neg, nneg0 += neg0;
+        /* the smooth field: each operator's error */
+        const double ex = sfree_lap(c.x[0][i], c.x[1][i], h);
+        double st = 0;
+        for (size_t k = nb.start[i]; k < nb.end[i]; k++)
+            if (nb.w[k] > 0) st += cstd * nb.w[k] * (fs[nb.j[k]] - fs[i]);
+        const double e1 = apply_row(&nb, cb, fs, i) - ex, e2 = apply_row(&nb, c0, fs, i) - ex,
+                     e3 = apply_row(&nb, cl, fs, i) - ex, e4 = apply_row(&nb, cl0, fs, i) - ex;
+        sb += e1 * e1, s0 += e2 * e2, sl += e3 * e3, sl0 += e4 * e4, sstd += (st - ex) * (st - ex);
+        sr += ex * ex;
+        /* the objective with the row minimised directly: (M + mu r r^T) a = sum_j w p df */
+        double M[10][10] = {{0}}, rhs[10] = {0}, wsum = 0;
+        for (size_t k = nb.start[i]; k < nb.end[i]; k++) {
+            const double w = nb.w[k], sx = nb.dx[0][k] / l0, sy = nb.dx[1][k] / l0;
+            const double p[5] = {sx, sy, sx * sx, sy * sy, sx * sy}, df = fs[nb.j[k]] - fs[i];
+            wsum += w;
+            for (int a = 0; a < 5; a++) {
+                rhs[a] += w * p[a] * df;
+                for (int bb = 0; bb < 5; bb++) M[a][bb] += w * p[a] * p[bb];
+            }
+        }
+        /* d/dy of (s_x, s_y, s_x^2, s_y^2, s_x s_y) at s_b = (0, d/l0) */
+        const double db = d[i] / l0, r[5] = {0, 1, 0, 2 * db, 0};
+        const double mu = wsum * w_ref(d[i], re) * weight;
+        for (int a = 0; a < 5; a++)
+            for (int bb = 0; bb < 5; bb++) M[a][bb] += mu * r[a] * r[bb];
+        double av[10];
+        dense_solve(5, M, rhs, av);
+        const double lap = 2.0 / (l0 * l0) * (av[2] + av[3]);
+        dmax = fmax(dmax, fabs(lap - apply_row(&nb, cl, fs, i)));
+        dscale = fmax(dscale, fabs(lap));
+    }
+    printf(
+        "  weight %g, half-plane, %zu rows cut by the surface (%zu flagged): a quadratic with "
+        "du/dn = 0 at the surface: max error %.3g of 7 with the row (stabilized, min theta %.3g; "
+        "LSMPS %.3g), %.3g without (stabilized, exact in %zu rows); one without: %.3g (LSMPS "
+        "without the row %.3g)\n",
+        weight, nrows, nflag, ea, thmin, ela, ea0, nexact0, eb, ebl0);
+    printf("  LSMPS rows with a negative coefficient: %zu with the row, %zu without; the "
+           "objective minimised directly against the coefficients: max difference %.3g of %.3g\n",
+           nneg, nneg0, dmax, dscale);
+    const double rb = sqrt(sb / sr), r0 = sqrt(s0 / sr), rl = sqrt(sl / sr), rl0 = sqrt(sl0 / sr),
+                 rs = sqrt(sstd / sr);
+    printf("  smooth field with du/dn = 0 at the surface, relative RMS error of these rows: "
+           "stabilized %.3g with the row, %.3g without; LSMPS %.3g with, %.3g without; T-3 %.3g\n",
+           rb, r0, rl, rl0, rs);
+    CHECK(nrows > 30 && nflag == 0);
+    CHECK(ela <= 1e-9 * 7);              /* LSMPS with the row: exact, whatever the weight */
+    CHECK(ea0 > 0.1 && nexact0 < nrows); /* the blend without the row is not */
+    CHECK(eb > 1 && ebl0 < 1e-9 * 7);    /* the violating field: the row is in the fit */
+    CHECK(dmax <= 1e-8 * dscale);
+    if (weight <= 1) {
+        /* a row of the neighbours' weight: the stabilized rows are all LSMPS's (theta 1),
+         * exact, and the row restores the sign that LSMPS loses at the surface */
+        CHECK(thmin == 1.0 && ea <= 1e-9 * 7);
+        CHECK(nneg == 0 && nneg0 > 0);
+    }
+    CHECK(rb < 0.5 * r0 && rb < rl0 && rb < rs);
+    free(cb), free(c0), free(cl), free(cl0), free(tb), free(t0), free(qa), free(qb), free(fs);
+    free(gb), free(g0), free(gl), free(gl0), free(d);
+    for (int k = 0; k < 3; k++) free(n[k]);
+    lub_neighbours_free(&nb);
+    cloud_free(&c);
+}
+static void test_surface_rows(void)
+{
+    check_surface_rows(1.0);
+    check_surface_rows(LUB_LSMPS_BC_WEIGHT);
+}
+
+/* The Dirichlet row (the free surface's P = 0 at x_b): the coefficient L_ib of the boundary
+ * value against the objective minimised directly, (M + mu r r^T) a = sum_j w p (f_j - f_i) +
+ * mu r (0 - f_i), r = p(s_b), on the half-plane; and a quadratic that vanishes on the surface,
+ * f = (y - h)(2 + x - 3 (y - h)) (lap -6), reproduced exactly. */
+static void test_surface_dirichlet(void)
+{
+    const double l0 = 0.1, re = 3.1 * l0, h = 0.5 * l0;
+    rng_state = 88172645463325252ull;
+    cloud c;
+    biased(&c, 0);
+    lub_neighbours nb;
+    build_open(&nb, &c, 2, re);
+    double *n[3], *d = malloc(c.n * sizeof *d), *diag = calloc(c.n, sizeof *diag);
+    for (int k = 0; k < 3; k++) n[k] = malloc(c.n * sizeof *n[k]);
+    bc_half_plane(&c, l0, re, n, d);
+    const lub_lsmps_bc bc = {
+        LUB_LSMPS_BC_DIRICHLET, {n[0], n[1], n[2]}, d, LUB_LSMPS_BC_WEIGHT, re / l0, diag};
+    double *cl = malloc(nb.npairs * sizeof *cl), *f = malloc(c.n * sizeof *f),
+           *g = malloc(c.n * sizeof *g);
+    uint8_t *fl = calloc(c.n, 1);
+    lub_mps_lsmps_laplacian(&nb, NULL, 2, l0, 0.0, &bc, cl, fl);
+    for (size_t i = 0; i < c.n; i++) {
+        const double x = c.x[0][i], y = c.x[1][i];
+        f[i] = sfree(x, y, h) + 0.4;
+        g[i] = (y - h) * (2 + x - 3 * (y - h));
+    }
+    size_t nrows = 0;
+    double dmax = 0, scale = 0, eq = 0;
+    for (size_t i = 0; i < c.n; i++) {
+        if (!looked_at(&c, 0, i) || !(d[i] > 0) || fl[i]) continue;
+        nrows++;
+        double M[10][10] = {{0}}, rhs[10] = {0}, wsum = 0;
+        for (size_t k = nb.start[i]; k < nb.end[i]; k++) {
+            const double w = nb.w[k], sx = nb.dx[0][k] / l0, sy = nb.dx[1][k] / l0;
+            const double p[5] = {sx, sy, sx * sx, sy * sy, sx * sy}, df = f[nb.j[k]] - f[i];
+            wsum += w;
+            for (int a = 0; a < 5; a++) {
+                rhs[a] += w * p[a] * df;
+                for (int bb = 0; bb < 5; bb++) M[a][bb] += w * p[a] * p[bb];
+            }
+        }
+        const double db = d[i] / l0, r[5] = {0, db, 0, db * db, 0};
+        const double mu = wsum * w_ref(d[i], re) * LUB_LSMPS_BC_WEIGHT;
+        for (int a = 0; a < 5; a++) {
+            rhs[a] += mu * r[a] * (0 - f[i]);
+            for (int bb = 0; bb < 5; bb++) M[a][bb] += mu * r[a] * r[bb];
+        }
+        double av[10];
+        dense_solve(5, M, rhs, av);
+        const double lap = 2.0 / (l0 * l0) * (av[2] + av[3]);
+        const double got = apply_row(&nb, cl, f, i) + diag[i] * (0 - f[i]);
+        dmax = fmax(dmax, fabs(lap - got)), scale = fmax(scale, fabs(lap));
+        eq = fmax(eq, fabs(apply_row(&nb, cl, g, i) + diag[i] * (0 - g[i]) + 6));
+    }
+    printf("  %zu rows: the objective with the Dirichlet row against the coefficients: max "
+           "difference %.3g of %.3g; a quadratic vanishing on the surface: error %.3g of 6\n",
+           nrows, dmax, scale, eq);
+    CHECK(nrows > 30);
+    CHECK(dmax <= 1e-8 * scale);
+    CHECK(eq <= 1e-9 * 6);
+    free(cl), free(f), free(g), free(fl), free(d), free(diag);
+    for (int k = 0; k < 3; k++) free(n[k]);
+    lub_neighbours_free(&nb);
+    cloud_free(&c);
+}
+
+/* A manufactured Poisson solution with a free surface: u = exp(x) cos(2y) + x^2 y^2 (du/dy = 0
+ * on y = 0) on the rectangle |x| < 1, -1.5 < y < 0 of particles jittered by 0.15 l0 (rows at
+ * y = -(k + 1/2) l0: the surface y = 0 half a spacing above the top row); the particles within
+ * l0 of the other three edges hold u (Dirichlet), nothing lies beyond the surface, the others
+ * solve sum_j L_ij (u_j - u_i) = lap u (= -3 exp(x) cos(2y) + 2 y^2 + 2 x^2) by BiCGStab.  op:
+ * 0 the standard Laplacian (T-3, whose missing neighbours act as du/dn = 0 at order zero), 1
+ * the stabilized one without the surface row, 2 with it (n = (0, 1), d = -y_i within re +
+ * l0/2 of the surface), 3 LSMPS (1.1) with it.  Returns the relative RMS error of u. */
+static double poisson_surface(double l0, int op)
+{
+    const double re = 3.1 * l0;
+    const int mx = (int)lround(1.0 / l0), my = (int)lround(1.5 / l0);
+    cloud c;
+    cloud_init(&c, (size_t)(2 * mx) * (size_t)my);
+    for (int j = 0; j < my; j++)
+        for (int i = 0; i < 2 * mx; i++) {
+            double p[3] = {-1 + (i + 0.5) * l0 + 0.15 * l0 * (2 * rnd() - 1),
+                           -(j + 0.5) * l0 + 0.15 * l0 * (2 * rnd() - 1), 0};
+            const int edge = p[0] < -1 + l0 || p[0] > 1 - l0 || p[1] < -1.5 + l0;
+            cloud_add(&c, p, edge);
+        }
+    lub_neighbours nb;
+    build_open(&nb, &c, 2, re);
+    lub_lsmps_stabilization o = options(2, l0, re);
+    lub_mps_mask mk = {c.kind, LUB_MPS_KIND(0), LUB_MPS_KIND(0) | LUB_MPS_KIND(1)};
+    double *coef = malloc(nb.npairs * sizeof *coef), *d = calloc(c.n, sizeof *d), *n[3];
+    for (int k = 0; k < 3; k++) n[k] = calloc(c.n, sizeof *n[k]);
+    for (size_t i = 0; i < c.n; i++) {
+        n[1][i] = 1;
+        d[i] = c.kind[i] == 0 && -c.x[1][i] < re + 0.5 * l0 ? -c.x[1][i] : 0.0;
+    }
+    const lub_lsmps_bc bc = {
+        LUB_LSMPS_BC_NEUMANN, {n[0], n[1], n[2]}, d, LUB_LSMPS_BC_WEIGHT, re / l0, NULL};
+    uint8_t *flag = calloc(c.n, 1);
+    if (op == 1 || op == 2) {
+        o.bc = op == 2 ? &bc : NULL;
+        CHECK(lub_mps_lsmps_stabilized(&nb, &mk, 2, l0, &o, coef, flag, NULL) == 0);
+    } else if (op == 3) {
+        CHECK(lub_mps_lsmps_laplacian(&nb, &mk, 2, l0, 0.0, &bc, coef, flag) == 0);
+    } else {
+        const double cstd = lub_mps_laplacian_coefficient(2, o.lambda0, o.n0, 1.0);
+        for (size_t q = 0; q < nb.npairs; q++) coef[q] = cstd * nb.w[q];
+    }
+    int *row = malloc(c.n * sizeof *row), nu = 0;
+    for (size_t i = 0; i < c.n; i++) row[i] = c.kind[i] == 0 ? nu++ : -1;
+    double *u = malloc(c.n * sizeof *u), *b = malloc(nu * sizeof *b), *x = calloc(nu, sizeof *x);
+    for (size_t i = 0; i < c.n; i++) {
+        const double X = c.x[0][i], Y = c.x[1][i];
+        u[i] = exp(X) * cos(2 * Y) + X * X * Y * Y;
+    }
+    lub_csr A;
+    lub_csr_init(&A);
+    lub_csr_begin(&A, nu);
+    for (size_t i = 0; i < c.n; i++) {
+        if (row[i] < 0) continue;
+        int len = 1;
+        for (size_t q = nb.start[i]; q < nb.end[i]; q++) len += nb.w[q] > 0 && row[nb.j[q]] >= 0;
+        lub_csr_set_row_length(&A, row[i], len);
+    }
+    lub_csr_alloc(&A);
+    for (size_t i = 0; i < c.n; i++) {
+        const int r = row[i];
+        if (r < 0) continue;
+        int *col = lub_csr_row_col(&A, r), e = 0;
+        double *val = lub_csr_row_val(&A, r), diag = 0;
+        const double X = c.x[0][i], Y = c.x[1][i];
+        b[r] = -(-3 * exp(X) * cos(2 * Y) + 2 * Y * Y + 2 * X * X);
+        for (size_t q = nb.start[i]; q < nb.end[i]; q++) {
+            const size_t j = nb.j[q];
+            if (nb.w[q] <= 0) continue;
+            diag += coef[q];
+            if (row[j] >= 0)
+                col[e] = row[j], val[e++] = -coef[q];
+            else
+                b[r] += coef[q] * u[j];
+        }
+        col[e] = r, val[e] = diag;
+    }
+    lub_csr_finish(&A);
+    lub_bicgstab_work w;
+    lub_bicgstab_work_init(&w);
+    lub_solve_result res;
+    CHECK(lub_bicgstab_solve(&w, &A, b, x, NULL, NULL, 1e-12, 20000, 0, &res) == LUB_SOLVE_OK);
+    double e2 = 0, r2 = 0;
+    for (size_t i = 0; i < c.n; i++)
+        if (row[i] >= 0) e2 += (x[row[i]] - u[i]) * (x[row[i]] - u[i]), r2 += u[i] * u[i];
+    lub_bicgstab_work_free(&w);
+    lub_csr_free(&A);
+    free(coef), free(d), free(flag), free(row), free(u), free(b), free(x);
+    for (int k = 0; k < 3; k++) free(n[k]);
+    lub_neighbours_free(&nb);
+    cloud_free(&c);
+    return sqrt(e2 / r2);
+}
+
+static void test_poisson_surface(void)
+{
+    static const char *const name[4] = {"standard", "stabilized", "stabilized + row",
+                                        "lsmps + row"};
+    double e[4][3] = {{0}};
+    rng_state = 88172645463325252ull; /* the draws whatever the tests before */
+    for (int k = 0; k < 3; k++)
+        for (int seed = 0; seed < 2; seed++)
+            for (int v = 0; v < 4; v++) {
+                const double x = poisson_surface(1.0 / (8 << k), v);
+                e[v][k] += 0.5 * x * x;
+            }
+    for (int k = 0; k < 3; k++) {
+        printf("  l0 = 1/%d: relative RMS error of u:", 8 << k);
+        for (int v = 0; v < 4; v++)
+            printf(" %s %.3g%s", name[v], sqrt(e[v][k]), v < 3 ? "," : "\n");
+    }
+    for (int k = 0; k < 2; k++) {
+        printf("  observed order 1/%d -> 1/%d:", 8 << k, 16 << k);
+        for (int v = 0; v < 4; v++)
+            printf(" %s %.2f%s", name[v], 0.5 * log2(e[v][k] / e[v][k + 1]), v < 3 ? "," : "\n");
+        CHECK(0.5 * log2(e[2][k] / e[2][k + 1]) >= 1.2); /* e[] holds squares: 0.5 log2 */
+    }
+    CHECK(0.5 * log2(e[0][0] / e[0][1]) < 1.2); /* the standard operator fails the same test */
+    for (int k = 0; k < 3; k++) CHECK(e[2][k] < 0.25 * e[1][k] && e[2][k] < e[0][k]);
+}
+
+/* The row's basis (lsmps.h, the derivative of p along n at s_b) with an oblique surface, 2-D
+ * and 3-D: particles of a lattice jittered by 0.15 l0 on the side n . x <= 0 of the plane
+ * n . x = h (h = l0/2), n = (1, 2)/sqrt 5 or (1, 2, 2)/3; the rows within re + l0/2 of the
+ * plane get the stress-free row.  u = 2 (n . x - h)^2 + (a . x)^2 + b . x with a, b along the
+ * plane (du/dn = 0 on it; lap 4 + 2 |a|^2) is exact in every such row of LSMPS with the row;
+ * u + 0.7 (n . x - h) is not. */
+static void check_oblique(int dim)
+{
+    const double l0 = 0.1, re = 3.1 * l0, h = 0.5 * l0, org[3] = {0, 0, 0};
+    const double n3[3] = {1.0 / 3, 2.0 / 3, 2.0 / 3}, n2[3] = {1 / sqrt(5.0), 2 / sqrt(5.0), 0};
+    const double *nv = dim == 3 ? n3 : n2;
+    const double a[3] = {dim == 3 ? 0 : -nv[1], dim == 3 ? 1 / sqrt(2.0) : nv[0],
+                         dim == 3 ? -1 / sqrt(2.0) : 0};
+    const double b[3] = {dim == 3 ? 4.0 / 3 : -2 * nv[1], dim == 3 ? -1.0 / 3 : 2 * nv[0],
+                         dim == 3 ? -1.0 / 3 : 0}; /* along the plane: n . b = 0 */
+    cloud all, c;
+    lattice(&all, dim, dim == 3 ? 6 : 10, l0, org, 0.15);
+    cloud_init(&c, all.n);
+    for (size_t i = 0; i < all.n; i++) {
+        const double p[3] = {all.x[0][i], all.x[1][i], all.x[2][i]};
+        if (p[0] * nv[0] + p[1] * nv[1] + p[2] * nv[2] <= 0) cloud_add(&c, p, 0);
+    }
+    lub_neighbours nb;
+    build_open(&nb, &c, dim, re);
+    double *n[3], *d = calloc(c.n, sizeof *d), *u = malloc(c.n * sizeof *u),
+                  *v = malloc(c.n * sizeof *v), *coef = malloc(nb.npairs * sizeof *coef);
+    uint8_t *flag = calloc(c.n, 1);
+    for (int k = 0; k < 3; k++) n[k] = malloc(c.n * sizeof *n[k]);
+    const double lap = 4 + 2 * (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    for (size_t i = 0; i < c.n; i++) {
+        double t = -h, ax = 0, bx = 0;
+        for (int k = 0; k < 3; k++) {
+            n[k][i] = nv[k];
+            t += nv[k] * c.x[k][i], ax += a[k] * c.x[k][i], bx += b[k] * c.x[k][i];
+        }
+        d[i] = -t < re + 0.5 * l0 ? -t : 0.0;
+        u[i] = 2 * t * t + ax * ax + bx;
+        v[i] = u[i] + 0.7 * t;
+    }
+    const lub_lsmps_bc bc = {
+        LUB_LSMPS_BC_NEUMANN, {n[0], n[1], n[2]}, d, LUB_LSMPS_BC_WEIGHT, re / l0, NULL};
+    lub_mps_lsmps_laplacian(&nb, NULL, dim, l0, 0.0, &bc, coef, flag);
+    size_t rows = 0, nflag = 0;
+    double eu = 0, ev = 0;
+    for (size_t i = 0; i < c.n; i++) {
+        int in = d[i] > 0;
+        for (int k = 0; k < dim; k++) in &= fabs(c.x[k][i]) < 2.5 * l0;
+        if (!in) continue;
+        rows++;
+        if (flag[i]) {
+            nflag++;
+            continue;
+        }
+        eu = fmax(eu, fabs(apply_row(&nb, coef, u, i) - lap));
+        ev = fmax(ev, fabs(apply_row(&nb, coef, v, i) - lap));
+    }
+    printf("  %d-D, oblique surface: %zu cut rows (%zu flagged); with du/dn = 0: max error %.3g "
+           "of %g; without: %.3g\n",
+           dim, rows, nflag, eu, lap, ev);
+    CHECK(rows >= 5 && nflag == 0);
+    CHECK(eu <= 1e-9 * lap);
+    CHECK(ev > 0.1);
+    free(d), free(u), free(v), free(coef), free(flag);
+    for (int k = 0; k < 3; k++) free(n[k]);
+    lub_neighbours_free(&nb);
+    cloud_free(&c);
+    cloud_free(&all);
+}
+static void test_surface_oblique(void)
+{
+    check_oblique(2);
+    check_oblique(3);
+}
+
 int main(void)
 {
     lub_set_quiet(1);
@@ -597,5 +1016,9 @@ int main(void)
     RUN(test_biased);
     RUN(test_objective);
     RUN(test_poisson);
+    RUN(test_surface_rows);
+    RUN(test_surface_dirichlet);
+    RUN(test_surface_oblique);
+    RUN(test_poisson_surface);
     return test_summary();
 }

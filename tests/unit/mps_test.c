@@ -1185,7 +1185,7 @@ static void check_lsmps_laplacian_poly(int dim)
     double *coef = malloc(nb.npairs * sizeof *coef), *f = malloc(c.n * sizeof *f),
            *lap = malloc(c.n * sizeof *lap);
     uint8_t *flag = calloc(c.n, 1);
-    lub_mps_lsmps_laplacian(&nb, NULL, dim, l0, 0.0, coef, flag);
+    lub_mps_lsmps_laplacian(&nb, NULL, dim, l0, 0.0, NULL, coef, flag);
     /* f = 3 + x - 2y + z + 1.5 x^2 - 0.7 xy + 2.5 y^2 (+ 0.8 z^2 - 1.1 yz): lap = 8 (9.6) */
     for (size_t i = 0; i < c.n; i++) {
         double x = c.x[0][i], y = c.x[1][i], z = c.x[2][i];
@@ -1242,7 +1242,7 @@ static void test_lsmps_laplacian_rate(void)
         double *coef = malloc(nb.npairs * sizeof *coef), *f = malloc(c.n * sizeof *f),
                *lap = malloc(c.n * sizeof *lap), *lstd = malloc(c.n * sizeof *lstd);
         uint8_t *flag = calloc(c.n, 1);
-        lub_mps_lsmps_laplacian(&nb, NULL, 2, l0, 0.0, coef, flag);
+        lub_mps_lsmps_laplacian(&nb, NULL, 2, l0, 0.0, NULL, coef, flag);
         for (size_t i = 0; i < c.n; i++) {
             double x = c.x[0][i], y = c.x[1][i];
             f[i] = sin(2 * x) * cos(3 * y) + x * x * y;
@@ -1289,7 +1289,7 @@ static void test_lsmps_laplacian_flag(void)
     double *coef = malloc((nb.npairs + 1) * sizeof *coef);
     for (size_t q = 0; q < nb.npairs; q++) coef[q] = -7.0;
     uint8_t flag[16] = {0};
-    CHECK(lub_mps_lsmps_laplacian(&nb, NULL, 2, 0.1, 0.0, coef, flag) == 10);
+    CHECK(lub_mps_lsmps_laplacian(&nb, NULL, 2, 0.1, 0.0, NULL, coef, flag) == 10);
     int untouched = 1;
     for (size_t q = 0; q < nb.npairs; q++) untouched &= coef[q] == -7.0;
     CHECK(untouched);
