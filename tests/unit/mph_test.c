@@ -617,6 +617,27 @@ static void test_hydrostatic(void)
             sl += pl[i], sk += P.p[i], nl++;
     printf("  bottom wall (%d particles): pLoad %.4g Pa, P (K-7a) %.4g Pa, rho0 g H %.4g Pa\n", nl,
            sl / nl, sk / nl, rho * -gy * H);
+    /* the split of P (K-7a) written as the field pKappa: kappa max(n_i - n0, 0), with n_i
+     * and s_i formed again here by lub_mph_operators at the final positions and velocities,
+     * and P_i - pKappa_i = lambda s_i, every particle (walls and dummies included) */
+    const double *pk = lub_particles_find_extra(&P, "pKappa");
+    double *pnd = malloc(P.n * sizeof *pnd), *div = malloc(P.n * sizeof *div);
+    lub_mph_operators(&m, pnd, div, NULL);
+    const double n0 = lub_mph_n0(2, l0);
+    double ek = 0, el = 0, pmax = 0;
+    for (size_t i = 0; pk && i < P.n; i++) {
+        ek = fmax(ek, fabs(pk[i] - c.bulk_modulus * fmax(pnd[i] - n0, 0.0)));
+        el = fmax(el, fabs(P.p[i] - pk[i] - c.bulk_viscosity * div[i]));
+        pmax = fmax(pmax, fabs(P.p[i]));
+    }
+    printf("  pKappa against kappa max(n - n0, 0): %.3g Pa; P - pKappa against lambda s: %.3g Pa "
+           "(P up to %.4g Pa)\n",
+           ek, el, pmax);
+    CHECK(pk != NULL);
+    CHECK(ek < 1e-9 * pmax);
+    CHECK(el < 1e-9 * pmax);
+    free(pnd);
+    free(div);
     CHECK(worst < 0.03);
     CHECK(klate < 1e-2 * kmax);
     CHECK(increases == 0);

@@ -246,6 +246,7 @@ typedef struct {
     size_t blk_cap;    /* blocks they hold (grown with the lists, rarely after the first steps) */
     size_t nfar;       /* bulk pairs (a, b) beyond the lists (none expected; counted) */
     double *pload;     /* the particle field pLoad (wall particles; see wall_load) */
+    double *pkout;     /* the particle field pKappa: P^kap_i, kappa's part of P */
     double *B;         /* divergence: corrected: B_i (3 x 3 per particle, row-major), NULL
                           with the plain sum (B_i = I; see correction) */
     double m0;         /* the lattice interior's -M = m0 I (correction) */
@@ -286,6 +287,7 @@ static mph_state *state(lub_mps *m)
     S->pos = lub_malloc(n * sizeof(int));
     for (size_t i = 0; i < n; i++) S->pos[i] = -1;
     S->pload = lub_particles_extra(m->P, "pLoad");
+    S->pkout = lub_particles_extra(m->P, "pKappa");
     if (m->c.divergence_corrected) {
         S->B = lub_calloc(9 * n, sizeof(double));
         S->m0 = lattice_m(m->dim);
@@ -671,6 +673,7 @@ lub_step_status lub_mph_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     lub_timer_start(&m->tm, LUB_T_GRADIENT);
     divergence(m, S, S->s);
     for (size_t i = 0; i < n; i++) P->p[i] = S->pk[i] + m->c.bulk_viscosity * S->s[i];
+    memcpy(S->pkout, S->pk, n * sizeof *S->pkout);
     wall_load(m, S);
     lub_timer_stop(&m->tm, LUB_T_GRADIENT);
 

@@ -13,7 +13,7 @@
  *   5. [rho0/dt I + V + C Lambda C^T] u^{k+1} = rho0/dt u* - C P^kap + wall terms: the d N
  *      fluid velocities at once, one SPD system (system/solution.yaml U)
  *   6. P_i = P^kap_i + lambda sum_j (u_ij.e_ij) w_p'_ij (K-7a) of every particle, walls
- *      included (their load: probe wallPressure)
+ *      included (their load: probe wallPressure); P^kap_i kept as the field pKappa
  *
  * divergence: corrected replaces the sum s_i = sum_j u_ij.g_ij of the bulk viscosity by
  * sum_j u_ij.B_i g_ij, B_i = -(sum_j g_ij r_ij^T)^-1, exact for linear fields (mph.c,
