@@ -44,6 +44,16 @@ void lub_par_read_dict(lub_par_dict *pd, const char *path, int dim, int nranks)
     pd->imbalance = lub_dict_real_or(bl, "imbalance", 0.1, LUB_NONNEGATIVE);
     pd->write = lub_dict_choice(root, "writeParticles", writes, 0);
     pd->margin = lub_dict_real_or(root, "margin", 0.2, LUB_NONNEGATIVE);
+    lub_node *wt = lub_dict_map_or(root, "weights");
+    static const char *const kinds[3] = {"fluid", "wall", "dummy"};
+    for (int k = 0; k < 3; k++) {
+        pd->weight[k] = lub_dict_real_or(wt, kinds[k], 1.0, LUB_POSITIVE);
+        if (pd->weight[k] < 1e-3 || pd->weight[k] > 1e3)
+            lub_node_error(lub_dict_find(wt, kinds[k]),
+                           "weights %s %g: expected a weight from 0.001 to 1000 (the kinds' "
+                           "shares of the work relative to each other)",
+                           kinds[k], pd->weight[k]);
+    }
     if (pd->write == LUB_PAR_WRITE_COLLECTIVE && !lub_particles_collective())
         lub_node_error(lub_dict_find(root, "writeParticles"),
                        "writeParticles collective, but this lubkit was built with the serial "
@@ -176,14 +186,18 @@ void lub_par_free(lub_par *d)
 {
     (void)d;
 }
+void lub_par_set_weights(lub_par *d, const double w[3])
+{
+    (void)d, (void)w;
+}
 int lub_par_longest_axis(const lub_particles *P)
 {
     (void)P;
     NO_MPI("lub_par_longest_axis")
 }
-void lub_par_quantiles(const double *x, size_t n, int parts, double *cut)
+void lub_par_quantiles(const double *x, const uint64_t *w, size_t n, int parts, double *cut)
 {
-    (void)x, (void)n, (void)parts, (void)cut;
+    (void)x, (void)w, (void)n, (void)parts, (void)cut;
     NO_MPI("lub_par_quantiles")
 }
 size_t lub_par_distribute(lub_par *d, const lub_particles *S, const uint64_t *place,
@@ -409,6 +423,7 @@ void lub_par_init(lub_par *d, int axis, double width, double lo, double hi, int 
     d->period = periodic ? hi - lo : 0.0;
     d->rank = rank_;
     d->size = size_;
+    d->wkind[0] = d->wkind[1] = d->wkind[2] = 1;
     d->cut = lub_calloc((size_t)size_ + 1, sizeof *d->cut);
     d->sel = lub_calloc(3 * ((size_t)size_ + 1), sizeof *d->sel);
     int **a[] = {&d->scount, &d->sdispl,  &d->rcount, &d->rdispl,
@@ -462,6 +477,8 @@ void lub_par_free(lub_par *d)
     free(d->sbuf);
     free(d->rbuf);
     free(d->keys);
+    free(d->cw);
+    free(d->wts);
     free(d->sel);
     free(d->kcut), free(d->mark), free(d->pairs);
     free(d->nb_owner), free(d->nb_tag);
@@ -566,6 +583,15 @@ static void move_particle(lub_particles *P, size_t k, size_t i)
     for (int e = 0; e < P->nextra; e++) P->extra[e].v[k] = P->extra[e].v[i];
 }
 
+/* The weights in units of 1/1000 (a weight 0.001-1000 a particle, exact integer sums: 16 M
+ * particles of weight 1000 sum to 1.6e13, far below 2^64). */
+void lub_par_set_weights(lub_par *d, const double w[3])
+{
+    for (int k = 0; k < 3; k++) d->wkind[k] = (uint64_t)llround(1000.0 * w[k]);
+    d->weighted = d->wkind[0] != d->wkind[1] || d->wkind[0] != d->wkind[2];
+    if (!d->weighted) d->wkind[0] = d->wkind[1] = d->wkind[2] = 1;
+}
+
 /* ---- the cuts: quantiles by a parallel selection ----------------------------------------- */
 
 /* A double as an unsigned integer of the same order (IEEE 754: a positive number with its
@@ -608,15 +634,20 @@ static uint64_t count_upto(const uint64_t *keys, size_t n, uint64_t v)
 
 /* The exact selection over all ranks' keys (this rank's n, sorted), with the caller's
  * buffer sel (3 (parts + 1)): sel[r] (r = 1 .. parts - 1) becomes the floor(r N / parts)-th
- * smallest key of all ranks (from 0), found by bisecting the keys' 64 bits: at each of at
+ * smallest key of all ranks (from 0; weighted, cw given, the running sums of the sorted keys'
+ * weights: the smallest key whose keys up to it weigh more than floor(r W / parts), W the
+ * total weight), found by bisecting the keys' 64 bits: at each of at
  * most 64 rounds every rank counts its keys up to the middle of each cut's interval (a
  * binary search in its sorted keys) and one MPI_Allreduce sums the counts of all cuts, so
  * the memory is this rank's keys and O(parts), never all N.  The result is the whole
  * sort's (the all-gather this replaced), equal keys (a lattice's column, a cell of the
- * curve) together on the rank of the first.  Returns N (0: sel untouched). */
-static uint64_t select_keys(const uint64_t *keys, size_t n, int parts, uint64_t *sel)
+ * curve) together on the rank of the first.  Returns N or W (0: sel untouched). */
+static uint64_t select_keys(const uint64_t *keys, const uint64_t *cw, size_t n, int parts,
+                            uint64_t *sel)
 {
-    const uint64_t total = (uint64_t)lub_par_sum_long((long)n);
+    const uint64_t mine = cw ? (n ? cw[n - 1] : 0) : n;
+    uint64_t total = 0;
+    MPI_Allreduce(&mine, &total, 1, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
     if (total == 0) return 0;
     uint64_t range[2] = {n ? keys[0] : UINT64_MAX, n ? ~keys[n - 1] : UINT64_MAX};
     MPI_Allreduce(MPI_IN_PLACE, range, 2, MPI_UINT64_T, MPI_MIN, MPI_COMM_WORLD);
@@ -626,7 +657,11 @@ static uint64_t select_keys(const uint64_t *keys, size_t n, int parts, uint64_t 
         int busy = 0;
         for (int r = 1; r < parts; r++) {
             cnt[r] = 0;
-            if (lo[r] < hi[r]) cnt[r] = count_upto(keys, n, lo[r] + (hi[r] - lo[r]) / 2), busy = 1;
+            if (lo[r] < hi[r]) {
+                const uint64_t a = count_upto(keys, n, lo[r] + (hi[r] - lo[r]) / 2);
+                cnt[r] = cw ? (a ? cw[a - 1] : 0) : a; /* the weight of the keys up to it */
+                busy = 1;
+            }
         }
         if (!busy) break; /* every rank sees the same intervals: all stop together */
         MPI_Allreduce(MPI_IN_PLACE, cnt + 1, parts - 1, MPI_UINT64_T, MPI_SUM, MPI_COMM_WORLD);
@@ -643,16 +678,14 @@ static uint64_t select_keys(const uint64_t *keys, size_t n, int parts, uint64_t 
     return total;
 }
 
-/* The cuts of lub_par_quantiles with the caller's buffers: keys (n), sel (3 (parts + 1)):
- * the coordinates' order-preserving keys selected exactly (select_keys). */
-static void quantiles(const double *x, size_t n, int parts, double *cut, uint64_t *keys,
+/* Slabs' cuts from this rank's n sorted keys of the coordinates (cw: their weights' running
+ * sums, NULL: counts), selected exactly over all ranks (select_keys), sel its buffer. */
+static void slab_cuts(const uint64_t *keys, const uint64_t *cw, size_t n, int parts, double *cut,
                       uint64_t *sel)
 {
-    for (size_t i = 0; i < n; i++) keys[i] = order_key(x[i]);
-    qsort(keys, n, sizeof *keys, cmp_key);
     cut[0] = -INFINITY;
     cut[parts] = INFINITY;
-    if (select_keys(keys, n, parts, sel) == 0) {
+    if (select_keys(keys, cw, n, parts, sel) == 0) {
         for (int r = 1; r < parts; r++) cut[r] = 0.0;
         return;
     }
@@ -662,35 +695,70 @@ static void quantiles(const double *x, size_t n, int parts, double *cut, uint64_
     }
 }
 
-void lub_par_quantiles(const double *x, size_t n, int parts, double *cut)
-{
-    uint64_t *keys = lub_malloc((n ? n : 1) * sizeof *keys);
-    uint64_t *sel = lub_malloc(3 * ((size_t)parts + 1) * sizeof *sel);
-    quantiles(x, n, parts, cut, keys, sel);
-    free(keys);
-    free(sel);
-}
-
 static void *grow_buf(unsigned char **b, size_t *cap, size_t bytes);
 static long displs(const int *count, int *displ, int size);
 
-/* The cuts of d at the quantiles of P's first n particles over all ranks, with d's buffers:
- * slabs, of their coordinate on the axis; sfc, of their cells' keys (the ranges of the
- * curve: each rank about N / P particles, a cell never divided).  A new cut empties the
- * cache of the cells' neighbour owners. */
+/* n keys with their weights w (NULL: unweighted), sorted by key in keys; returns the running
+ * sums of the weights in key order in the buffer *kwb (NULL when unweighted).  The (key,
+ * weight) pairs are sorted in the buffer (by the key, the pair's first word), then the sums
+ * written over them from the front: sum i lands on word i, which belongs to pair i/2 <= i,
+ * read already. */
+static const uint64_t *sort_weighted(uint64_t *keys, const uint64_t *w, size_t n,
+                                     unsigned char **kwb, size_t *cap)
+{
+    if (!w) {
+        qsort(keys, n, sizeof *keys, cmp_key);
+        return NULL;
+    }
+    uint64_t *kw = grow_buf(kwb, cap, 2 * (n ? n : 1) * sizeof(uint64_t));
+    for (size_t i = 0; i < n; i++) kw[2 * i] = keys[i], kw[2 * i + 1] = w[i];
+    qsort(kw, n, 2 * sizeof *kw, cmp_key);
+    uint64_t sum = 0;
+    for (size_t i = 0; i < n; i++) {
+        keys[i] = kw[2 * i];
+        sum += kw[2 * i + 1];
+        kw[i] = sum;
+    }
+    return kw;
+}
+
+void lub_par_quantiles(const double *x, const uint64_t *w, size_t n, int parts, double *cut)
+{
+    uint64_t *keys = lub_malloc((n ? n : 1) * sizeof *keys);
+    uint64_t *sel = lub_malloc(3 * ((size_t)parts + 1) * sizeof *sel);
+    unsigned char *kwb = NULL;
+    size_t cap = 0;
+    for (size_t i = 0; i < n; i++) keys[i] = order_key(x[i]);
+    slab_cuts(keys, sort_weighted(keys, w, n, &kwb, &cap), n, parts, cut, sel);
+    free(keys);
+    free(sel);
+    free(kwb);
+}
+
+/* The cuts of d at the quantiles of P's first n particles over all ranks (weighted: of their
+ * weights), with d's buffers: slabs, of their coordinate on the axis; sfc, of their cells'
+ * keys (the ranges of the curve: each rank about N / P particles, or 1 / P of the weight, a
+ * cell never divided).  A new cut empties the cache of the cells' neighbour owners. */
 static void cut_at_quantiles(lub_par *d, const lub_particles *P, size_t n)
 {
     uint64_t *keys = grow_buf(&d->keys, &d->keys_cap, (n ? n : 1) * sizeof(uint64_t));
-    if (d->method != LUB_PAR_SFC) {
-        quantiles(P->x[d->axis], n, d->size, d->cut, keys, d->sel);
+    const int slabs = d->method != LUB_PAR_SFC;
+    for (size_t i = 0; i < n; i++)
+        keys[i] = slabs ? order_key(P->x[d->axis][i]) : particle_key(d, P, i);
+    uint64_t *w = NULL; /* weighted: the particles' weights, then their running sums */
+    if (d->weighted) {
+        w = grow_buf(&d->wts, &d->wts_cap, (n ? n : 1) * sizeof(uint64_t));
+        for (size_t i = 0; i < n; i++) w[i] = d->wkind[P->kind[i]];
+    }
+    const uint64_t *cw = sort_weighted(keys, w, n, &d->cw, &d->cw_cap);
+    if (slabs) {
+        slab_cuts(keys, cw, n, d->size, d->cut, d->sel);
         return;
     }
-    for (size_t i = 0; i < n; i++) keys[i] = particle_key(d, P, i);
-    qsort(keys, n, sizeof *keys, cmp_key);
     const int size = d->size;
     d->kcut[0] = 0;
     d->kcut[size] = UINT64_MAX;
-    const int any = select_keys(keys, n, size, d->sel) > 0;
+    const int any = select_keys(keys, cw, n, size, d->sel) > 0;
     for (int r = 1; r < size; r++) {
         d->kcut[r] = any ? d->sel[r] : 0;
         if (d->kcut[r] < d->kcut[r - 1]) d->kcut[r] = d->kcut[r - 1];
@@ -698,10 +766,20 @@ static void cut_at_quantiles(lub_par *d, const lub_particles *P, size_t n)
     if (d->nb_tag) memset(d->nb_tag, 0, d->ncache * sizeof *d->nb_tag);
 }
 
+/* This rank's owned weight (weighted cuts) or count. */
+static double owned_load(const lub_par *d, const lub_particles *P)
+{
+    if (!d->weighted) return (double)d->nown;
+    uint64_t w = 0;
+    for (size_t i = 0; i < d->nown; i++) w += d->wkind[P->kind[i]];
+    return (double)w;
+}
+
 int lub_par_rebalance(lub_par *d, const lub_particles *P, double imbalance)
 {
     const double t0 = lub_wtime();
-    const double most = lub_par_max((double)d->nown), mean = (double)d->ntotal / d->size;
+    const double load = owned_load(d, P);
+    const double most = lub_par_max(load), mean = lub_par_sum(load) / d->size;
     int recut = 0;
     if (most > (1 + imbalance) * mean) {
         const long total = lub_par_sum_long((long)d->nown);

@@ -69,6 +69,8 @@
  *                                    # Open MPI's HDF5) | gather (to rank 0) | auto
  *     margin: 0.2                    # a slab's room at the start beyond its particles and
  *                                    # halo, for the migration (re-sized when it fills)
+ *     weights: { fluid: 1, wall: 1, dummy: 1 }   # each kind's share of the work: the cuts
+ *                                    # give every rank the same sum of weights
  *
  * Read from path for a dim-D case; nranks > 0: numberOfSubdomains must equal it (an error
  * at its line naming both otherwise).  Fatal (exit 1) at file:line on bad input. */
@@ -80,6 +82,7 @@ typedef struct {
     double imbalance; /* balance.imbalance */
     int write;        /* writeParticles: LUB_PAR_WRITE_* */
     double margin;    /* margin */
+    double weight[3]; /* weights of LUB_FLUID, LUB_WALL, LUB_DUMMY */
 } lub_par_dict;
 enum { LUB_PAR_WRITE_AUTO, LUB_PAR_WRITE_COLLECTIVE, LUB_PAR_WRITE_GATHER };
 void lub_par_read_dict(lub_par_dict *pd, const char *path, int dim, int nranks);
@@ -158,6 +161,15 @@ typedef struct {
     void (*grow)(void *ctx, size_t n, const char *what);
     void *grow_ctx;
     double margin; /* the room a re-size leaves beyond n (decomposeParDict margin) */
+    /* The cuts' weights per kind (LUB_FLUID, LUB_WALL, LUB_DUMMY), in integer units (exact
+     * sums over the ranks); all equal: the cuts count particles.  lub_par_set_weights. */
+    uint64_t wkind[3];
+    int weighted;
+    unsigned char *cw; /* the selection's (key, weight) pairs, then the running sums of the
+                        * weights in key order (this rank's) */
+    size_t cw_cap;
+    unsigned char *wts; /* the particles' weights for the selection */
+    size_t wts_cap;
     long nresized; /* re-sizes so far */
     /* sfc: the cells of the curve and the ranges of keys */
     int dim;
@@ -187,6 +199,10 @@ void lub_par_init(lub_par *d, int axis, double width, double lo, double hi, int 
 void lub_par_init_sfc(lub_par *d, int dim, double cell, const double lo[3], const double hi[3],
                       const int periodic[3]);
 void lub_par_free(lub_par *d);
+/* The cuts' weights of the fluid, wall and dummy particles (decomposeParDict weights; > 0):
+ * every rank's slab or range then holds about the same sum of weights, and the re-balancing
+ * compares the ranks' sums.  Equal weights (the default): particle counts. */
+void lub_par_set_weights(lub_par *d, const double w[3]);
 /* The index along the Hilbert curve of the cell c (dim 2 or 3, each coordinate below
  * 2^bits, dim x bits <= 63): the curve visits every cell of the 2^bits cube once, each step
  * to a cell sharing a face (J. Skilling, Programming the Hilbert curve, AIP Conf. Proc. 707,
@@ -201,8 +217,10 @@ int lub_par_longest_axis(const lub_particles *P);
  * -inf, cut[parts] = +inf and cut[r] the floor(r N / parts)-th smallest of the N coordinates
  * (from 0; 0 when N = 0), exactly what sorting all of them gives, by a parallel selection
  * (at most 64 rounds of one MPI_Allreduce of parts - 1 counts; memory: n and O(parts)).
- * Collective. */
-void lub_par_quantiles(const double *x, size_t n, int parts, double *cut);
+ * w (NULL: all 1): the coordinates' integer weights, and cut[r] the smallest coordinate
+ * whose coordinates up to it weigh more than floor(r W / parts), W their total (the cuts of
+ * decomposeParDict weights).  Collective. */
+void lub_par_quantiles(const double *x, const uint64_t *w, size_t n, int parts, double *cut);
 /* The start on the slabs: S holds this rank's slice of the start's file (any rows; the
  * slices of all ranks together every particle once), place[i] the solver's place of S's
  * particle i (/solver/order).  The cuts at the quantiles of the axis coordinate over all

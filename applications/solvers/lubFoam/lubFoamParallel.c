@@ -72,6 +72,7 @@ void lubfoam_parallel_distribute(lubfoam_run *r, const lub_geometry *geo, const 
     r->par.interval = r->pd.interval;
     r->par.imbalance = r->pd.imbalance;
     r->par.margin = r->pd.margin;
+    lub_par_set_weights(&r->par, r->pd.weight);
     r->most = lub_par_distribute(&r->par, S, place, &r->P, path);
 }
 
@@ -85,10 +86,11 @@ void lubfoam_parallel_capacity(lubfoam_run *r, const lub_mps_config *cfg)
     if (r->P.nlevels != 1)
         lub_fatal("%s: resolution levels do not run in parallel yet", sc->models_path);
     if (LUB_LAPLACIAN_FITTED(cfg->lap_pressure) || LUB_LAPLACIAN_FITTED(cfg->lap_viscosity))
-        lub_fatal("%s/system/schemes.yaml: the LSMPS Laplacians (laplacian: lsmps, "
-                  "lsmpsStabilized) do not run in parallel yet (their BiCGStab solve is serial): use "
-                  "laplacian: standard",
-                  r->cs.root);
+        lub_fatal(
+            "%s/system/schemes.yaml: the LSMPS Laplacians (laplacian: lsmps, "
+            "lsmpsStabilized) do not run in parallel yet (their BiCGStab solve is serial): use "
+            "laplacian: standard",
+            r->cs.root);
     const int implicit = cfg->viscosity == LUB_VISCOSITY_CN;
     const int p_bad = cfg->p_solver.kind != LUB_LINSOLVER_PETSC;
     if (p_bad || (implicit && cfg->v_solver.kind != LUB_LINSOLVER_PETSC))
@@ -167,6 +169,10 @@ void lubfoam_parallel_setup(lubfoam_run *r, const lubfoam_functions *fos)
                     "case",
                     r->pd.margin, cap, total ? 100 * cap / (double)total : 0.0);
     }
+    if (r->par.weighted)
+        lub_message("Weights: the cuts give each rank about 1/%d of the particles' weight, "
+                    "fluid %g, wall %g, dummy %g (decomposeParDict weights), not of their count",
+                    size, r->pd.weight[0], r->pd.weight[1], r->pd.weight[2]);
     /* the particle files: collective when the build's HDF5 is Open MPI's and the ids are
      * the rows (0 .. N-1, as particleGen numbers them), else gathered to rank 0 */
     const int dense = lub_par_ids_dense(&r->par, &r->P);
