@@ -135,16 +135,18 @@ static void hydrostatic(const char *dict, double width, double nu, int lap)
     lub_geometry_free(&g);
 }
 
+/* The water tank of the hydrostatic tests: 20 x 20 particles in a box twice as high. */
+static const char TANK[] = "dimension: 2\n"
+                           "l0: 0.005\n"
+                           "domain: { min: [-0.02, -0.02], max: [0.12, 0.2] }\n"
+                           "walls:\n"
+                           "  tank: { type: box, min: [0, 0], max: [0.1, 0.2], fluid: inside }\n"
+                           "fluid:\n"
+                           "  - { type: box, min: [0, 0], max: [0.1, 0.1] }\n";
+
 static void test_hydrostatic(void)
 {
-    hydrostatic("dimension: 2\n"
-                "l0: 0.005\n"
-                "domain: { min: [-0.02, -0.02], max: [0.12, 0.2] }\n"
-                "walls:\n"
-                "  tank: { type: box, min: [0, 0], max: [0.1, 0.2], fluid: inside }\n"
-                "fluid:\n"
-                "  - { type: box, min: [0, 0], max: [0.1, 0.1] }\n",
-                0.1, 1e-4, LUB_LAPLACIAN_STANDARD);
+    hydrostatic(TANK, 0.1, 1e-4, LUB_LAPLACIAN_STANDARD);
 }
 
 /* The same with the LSMPS Laplacian in the viscosity and the pressure equation
@@ -152,28 +154,14 @@ static void test_hydrostatic(void)
  * inside, the same tolerance. */
 static void test_hydrostatic_lsmps(void)
 {
-    hydrostatic("dimension: 2\n"
-                "l0: 0.005\n"
-                "domain: { min: [-0.02, -0.02], max: [0.12, 0.2] }\n"
-                "walls:\n"
-                "  tank: { type: box, min: [0, 0], max: [0.1, 0.2], fluid: inside }\n"
-                "fluid:\n"
-                "  - { type: box, min: [0, 0], max: [0.1, 0.1] }\n",
-                0.1, 1e-4, LUB_LAPLACIAN_LSMPS);
+    hydrostatic(TANK, 0.1, 1e-4, LUB_LAPLACIAN_LSMPS);
 }
 
 /* The same with the stabilized LSMPS Laplacian (laplacian: lsmpsStabilized; lsmps.h): LSMPS
  * blended towards T-3 by the fit's own conditioning, no switch at the free surface. */
 static void test_hydrostatic_stabilized(void)
 {
-    hydrostatic("dimension: 2\n"
-                "l0: 0.005\n"
-                "domain: { min: [-0.02, -0.02], max: [0.12, 0.2] }\n"
-                "walls:\n"
-                "  tank: { type: box, min: [0, 0], max: [0.1, 0.2], fluid: inside }\n"
-                "fluid:\n"
-                "  - { type: box, min: [0, 0], max: [0.1, 0.1] }\n",
-                0.1, 1e-4, LUB_LAPLACIAN_STABILIZED);
+    hydrostatic(TANK, 0.1, 1e-4, LUB_LAPLACIAN_STABILIZED);
 }
 
 /* 3-D: a tank 10 x 10 particles wide, 12 deep (l0 = 8 mm).  The error falls with the
