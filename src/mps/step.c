@@ -732,19 +732,29 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
                     memcpy(val, lub_csr_row_val(&m->A, r), (size_t)len * sizeof *val);
                     continue;
                 }
-                double asum = 0, rhs[3] = {0, 0, 0};
+                double asum = 0, rhs[3] = {0, 0, 0}, kap[3] = {0, 0, 0};
                 int e = 0;
+                /* flux: a wall particle's Dirichlet value carries the slip of (2.8b), as in
+                 * the standard rows above: the fit then holds the parabola plus the slip on
+                 * the rows, whose trapezoid sum is the film's flux to O((l0/h)^3) */
+                lub_mps_ghost_planes gp;
+                if (flux) ghost_setup(m, i, g, &gp, kap);
                 for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
                     const size_t j = nb->j[q];
                     if (nb->w[q] <= 0) continue;
                     const double a = P->kind[j] == LUB_DUMMY ? 0.0 : m->lapc[q];
+                    double uj[3] = {P->u[0][j], P->u[1][j], P->u[2][j]}, s[3];
+                    if (flux && P->kind[j] == LUB_WALL) {
+                        lub_mps_ghost(m, i, j, &gp, kap, s);
+                        for (int d = 0; d < dim; d++) uj[d] += s[d];
+                    }
                     asum += a;
-                    for (int d = 0; d < dim; d++) rhs[d] += a * (P->u[d][j] - P->u[d][i]);
+                    for (int d = 0; d < dim; d++) rhs[d] += a * (uj[d] - P->u[d][i]);
                     if (m->row[j] >= 0) {
                         col[e] = m->row[j];
                         val[e++] = -h * a;
                     } else {
-                        for (int d = 0; d < dim; d++) rhs[d] += a * P->u[d][j];
+                        for (int d = 0; d < dim; d++) rhs[d] += a * uj[d];
                     }
                 }
                 col[e] = r;

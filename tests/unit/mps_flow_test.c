@@ -738,8 +738,11 @@ static void test_compression(void)
  * 1 - (l0/H)^2 of the closed form's f H^3/(12 nu) (6.25% short here).  `flux` adds the slip
  * u_s = -kappa l0^2/12 (methods.md (2.8b)): the profile is the parabola plus u_s and the rate
  * 1 - (l0/H)^3 of the closed form's (1.6% short), held to 1.5 (l0/H)^3; the profile against
- * the parabola shifted by u_s to 1%. */
-static double narrow_poiseuille(int dummy, double *rate)
+ * the parabola shifted by u_s to 1%.  The fitted viscosity (laplacian.viscosity lsmps or
+ * lsmpsStabilized, lap) takes the wall particles' velocities as Dirichlet values and no
+ * dummies: exact for the parabola on the rows, so the trapezoid's deficit without flux, and
+ * with flux the same slip on the wall values and the same 1 - (l0/H)^3. */
+static double narrow_poiseuille(int dummy, int lap, double *rate)
 {
     lub_particles P = {0};
     lub_geometry g;
@@ -765,6 +768,7 @@ static double narrow_poiseuille(int dummy, double *rate)
     c.gravity = 1;
     c.g[0] = f.f;
     c.dummy_velocity = dummy;
+    c.lap_viscosity = lap;
     lub_mps m;
     lub_mps_init(&m, &P, &c, g.dmin, g.dmax, g.periodic);
     /* 20 diffusion times H^2/nu = 16 ms */
@@ -781,8 +785,11 @@ static double narrow_poiseuille(int dummy, double *rate)
     }
     const double e = sqrt(num / den);
     *rate = q / (f.f * f.H * f.H * f.H / (12 * f.nu)) - 1;
-    printf("  Poiseuille across 4 l0, dummyVelocity %s: relative L2 %.5f, flow rate %+.5f "
-           "(trapezoid -(l0/H)^2 = %+.5f, -(l0/H)^3 = %+.5f)\n",
+    printf("  Poiseuille across 4 l0, viscosity %s, dummyVelocity %s: relative L2 %.5f, flow "
+           "rate %+.5f (trapezoid -(l0/H)^2 = %+.5f, -(l0/H)^3 = %+.5f)\n",
+           lap == LUB_LAPLACIAN_STABILIZED ? "lsmpsStabilized"
+           : lap == LUB_LAPLACIAN_LSMPS    ? "lsmps"
+                                           : "standard",
            dummy == LUB_DUMMY_FLUX          ? "flux"
            : dummy == LUB_DUMMY_EXTRAPOLATE ? "extrapolate"
                                             : "mirror",
@@ -796,14 +803,24 @@ static double narrow_poiseuille(int dummy, double *rate)
 static void test_dummy_velocity(void)
 {
     double qx, qm, qf;
-    const double ex = narrow_poiseuille(LUB_DUMMY_EXTRAPOLATE, &qx);
-    const double em = narrow_poiseuille(LUB_DUMMY_MIRROR, &qm);
-    const double ef = narrow_poiseuille(LUB_DUMMY_FLUX, &qf);
+    const double ex = narrow_poiseuille(LUB_DUMMY_EXTRAPOLATE, LUB_LAPLACIAN_STANDARD, &qx);
+    const double em = narrow_poiseuille(LUB_DUMMY_MIRROR, LUB_LAPLACIAN_STANDARD, &qm);
+    const double ef = narrow_poiseuille(LUB_DUMMY_FLUX, LUB_LAPLACIAN_STANDARD, &qf);
     CHECK(ex < 0.01);
     CHECK(em > 0.05);
     CHECK(ef < 0.01);
     CHECK(fabs(qf) < 1.5 * pow(0.25, 3));
     CHECK(fabs(qx + 0.0625) < 0.1 * 0.0625); /* the trapezoid's deficit, which flux removes */
+    /* the fitted viscosity: the deficit with its exact walls, the slip with flux */
+    for (int lap = LUB_LAPLACIAN_LSMPS; lap <= LUB_LAPLACIAN_STABILIZED; lap++) {
+        double q0, q1;
+        const double e0 = narrow_poiseuille(LUB_DUMMY_MIRROR, lap, &q0);
+        const double e1 = narrow_poiseuille(LUB_DUMMY_FLUX, lap, &q1);
+        CHECK(e0 < 0.01);
+        CHECK(fabs(q0 + 0.0625) < 0.1 * 0.0625);
+        CHECK(e1 < 0.01);
+        CHECK(fabs(q1) < 1.5 * pow(0.25, 3));
+    }
 }
 
 int main(void)
