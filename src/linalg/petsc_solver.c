@@ -50,6 +50,13 @@ lub_solve_status lub_petsc_solve(lub_petsc *s, const lub_csr *A, int nrhs, const
     (void)s, (void)A, (void)nrhs, (void)b, (void)x, (void)o, (void)res;
     lub_bug("lub_petsc_solve in a build without PETSc");
 }
+lub_solve_status lub_petsc_solve_other(lub_petsc *s, const lub_csr *B, int nrhs,
+                                       const double *const *b, double *const *x,
+                                       const lub_pcg_options *o, lub_solve_result *res)
+{
+    (void)s, (void)B, (void)nrhs, (void)b, (void)x, (void)o, (void)res;
+    lub_bug("lub_petsc_solve_other in a build without PETSc");
+}
 
 #else
 
@@ -79,6 +86,14 @@ struct lub_petsc {
     const lub_csr *As; /* the CSR and stamp of the last set-up */
     unsigned long stamp;
     int ready;
+    /* lub_petsc_solve_other: the other operator B (its pattern, sorted rows as gcol/perm/
+     * gval) and its BiCGStab, preconditioned from A */
+    Mat B;
+    KSP kspb;
+    int bn, bnnz, *bptr, *bcol, bn_cap, bnnz_cap;
+    int *bgcol, *bperm;
+    double *bgval;
+    int bg_cap;
 };
 
 static char version[64];
@@ -125,8 +140,16 @@ lub_petsc *lub_petsc_new(const lub_petsc_options *o)
     return s;
 }
 
+static void destroy_other(lub_petsc *s)
+{
+    if (s->kspb) KSPDestroy(&s->kspb);
+    if (s->B) MatDestroy(&s->B);
+    s->bn = s->bnnz = 0;
+}
+
 static void destroy_objects(lub_petsc *s)
 {
+    destroy_other(s);
     if (s->ksp) KSPDestroy(&s->ksp);
     if (s->A) MatDestroy(&s->A);
     if (s->b) VecDestroy(&s->b);
@@ -145,6 +168,11 @@ void lub_petsc_free(lub_petsc *s)
     free(s->gcol);
     free(s->perm);
     free(s->gval);
+    free(s->bptr);
+    free(s->bcol);
+    free(s->bgcol);
+    free(s->bperm);
+    free(s->bgval);
     free(s);
 }
 
@@ -162,32 +190,39 @@ static int same_pattern(const lub_petsc *s, const lub_csr *A, const int *cols)
            !memcmp(s->col, cols, (size_t)A->nnz * sizeof *s->col);
 }
 
-/* A distributed matrix's rows in global columns (A->colmap of its local ones), each row
- * sorted, into s->gcol and its values into s->gval (s->perm: where each came from). */
-static void distributed_rows(lub_petsc *s, const lub_csr *A)
+/* A matrix's rows in global columns (A->colmap of its local ones; serial: its own), each
+ * row sorted, into gcol and its values into gval (perm: where each came from); the three
+ * arrays grow to *cap entries as needed (not in the time loop once the lists settle). */
+static void sorted_rows(const lub_csr *A, int **gcol, int **perm, double **gval, int *cap)
 {
-    if (A->nnz > s->g_cap) {
-        free(s->gcol), free(s->perm), free(s->gval);
-        s->g_cap = A->nnz + A->nnz / 8 + 16;
-        s->gcol = lub_malloc((size_t)s->g_cap * sizeof *s->gcol);
-        s->perm = lub_malloc((size_t)s->g_cap * sizeof *s->perm);
-        s->gval = lub_malloc((size_t)s->g_cap * sizeof *s->gval);
+    if (A->nnz > *cap) {
+        free(*gcol), free(*perm), free(*gval);
+        *cap = A->nnz + A->nnz / 8 + 16;
+        *gcol = lub_malloc((size_t)*cap * sizeof **gcol);
+        *perm = lub_malloc((size_t)*cap * sizeof **perm);
+        *gval = lub_malloc((size_t)*cap * sizeof **gval);
     }
+    int *gc = *gcol, *pm = *perm;
     for (int i = 0; i < A->n; i++) {
         const int a = A->row_ptr[i], b = A->row_ptr[i + 1];
         for (int k = a; k < b; k++) { /* insertion sort: a few tens of entries */
-            const int g = A->colmap[A->col[k]];
+            const int g = A->colmap ? A->colmap[A->col[k]] : A->col[k];
             int l = k - 1;
-            while (l >= a && s->gcol[l] > g) {
-                s->gcol[l + 1] = s->gcol[l];
-                s->perm[l + 1] = s->perm[l];
+            while (l >= a && gc[l] > g) {
+                gc[l + 1] = gc[l];
+                pm[l + 1] = pm[l];
                 l--;
             }
-            s->gcol[l + 1] = g;
-            s->perm[l + 1] = k;
+            gc[l + 1] = g;
+            pm[l + 1] = k;
         }
     }
-    for (int k = 0; k < A->nnz; k++) s->gval[k] = A->val[s->perm[k]];
+    for (int k = 0; k < A->nnz; k++) (*gval)[k] = A->val[pm[k]];
+}
+
+static void distributed_rows(lub_petsc *s, const lub_csr *A)
+{
+    sorted_rows(A, &s->gcol, &s->perm, &s->gval, &s->g_cap);
 }
 
 /* BoomerAMG's set-up is remade every step (the particles move, the matrix changes), so its
@@ -197,17 +232,20 @@ static void distributed_rows(lub_petsc *s, const lub_csr *A)
  * HMIS coarsening, extended+i interpolation truncated to 4 entries a row, one level of
  * aggressive coarsening; the 3-D roller at h0/3 (172,174 particles) 2.4 times faster per step
  * on one process, 4.2 pressure iterations a step against 3.1.  Entered in PETSc's options
- * database unless set there already: PETSC_OPTIONS in the environment overrides each. */
-static int hypre_defaults(void)
+ * database unless set there already: PETSC_OPTIONS in the environment overrides each.
+ * prefix: the KSP's options prefix ("" or "other_": lub_petsc_solve_other's). */
+static int hypre_defaults(const char *prefix)
 {
-    static const char *const opt[][2] = {{"-pc_hypre_boomeramg_coarsen_type", "HMIS"},
-                                         {"-pc_hypre_boomeramg_interp_type", "ext+i"},
-                                         {"-pc_hypre_boomeramg_P_max", "4"},
-                                         {"-pc_hypre_boomeramg_agg_nl", "1"}};
+    static const char *const opt[][2] = {{"pc_hypre_boomeramg_coarsen_type", "HMIS"},
+                                         {"pc_hypre_boomeramg_interp_type", "ext+i"},
+                                         {"pc_hypre_boomeramg_P_max", "4"},
+                                         {"pc_hypre_boomeramg_agg_nl", "1"}};
     for (size_t k = 0; k < sizeof opt / sizeof opt[0]; k++) {
+        char name[96];
+        snprintf(name, sizeof name, "-%s%s", prefix, opt[k][0]);
         PetscBool set = PETSC_FALSE;
-        TRY(PetscOptionsHasName(NULL, NULL, opt[k][0], &set));
-        if (!set) TRY(PetscOptionsSetValue(NULL, opt[k][0], opt[k][1]));
+        TRY(PetscOptionsHasName(NULL, NULL, name, &set));
+        if (!set) TRY(PetscOptionsSetValue(NULL, name, opt[k][1]));
     }
     return 0;
 fail:
@@ -225,7 +263,7 @@ static int make_ksp(lub_petsc *s)
     TRY(KSPGetPC(s->ksp, &pc));
     TRY(PCSetType(pc, pt[s->o.pc]));
     if (s->o.pc == LUB_PETSC_PC_HYPRE) {
-        TRY(hypre_defaults());
+        TRY(hypre_defaults(""));
         TRY(PCHYPRESetType(pc, "boomeramg"));
     }
     /* ||b - A x|| / ||b|| as lubkit's PCG: GMRES only knows it with right preconditioning */
@@ -324,23 +362,23 @@ static lub_solve_status reason_status(KSPConvergedReason why)
     }
 }
 
-/* ||b - A x|| / ||b|| of a distributed matrix (x, b placed in s->x, s->b), over all ranks */
-static double distributed_residual(lub_petsc *s, double bn)
+/* ||b - M x|| / ||b|| of a distributed matrix (x, b placed in s->x, s->b), over all ranks */
+static double distributed_residual(lub_petsc *s, Mat M, double bn)
 {
     PetscReal rn = 0.0;
-    if (MatMult(s->A, s->x, s->rv) || VecAYPX(s->rv, -1.0, s->b) || VecNorm(s->rv, NORM_2, &rn))
+    if (MatMult(M, s->x, s->rv) || VecAYPX(s->rv, -1.0, s->b) || VecNorm(s->rv, NORM_2, &rn))
         return NAN;
     return (double)rn / bn;
 }
 
-lub_solve_status lub_petsc_solve(lub_petsc *s, const lub_csr *A, int nrhs, const double *const *b,
-                                 double *const *x, const lub_pcg_options *o, lub_solve_result *res)
+/* Solve with ksp, whose operator is M (PETSc's copy of A, the same rows) */
+static lub_solve_status ksp_solve(lub_petsc *s, KSP ksp, Mat M, const lub_csr *A, int nrhs,
+                                  const double *const *b, double *const *x,
+                                  const lub_pcg_options *o, lub_solve_result *res)
 {
-    if (!s->ready || s->As != A || s->stamp != A->stamp)
-        lub_bug("lub_petsc_solve without a set-up of this matrix");
     lub_solve_status worst = LUB_SOLVE_OK;
-    if (KSPSetTolerances(s->ksp, o->tolerance, 0.0, PETSC_DEFAULT, o->max_iter) ||
-        KSPSetInitialGuessNonzero(s->ksp, o->warm_start ? PETSC_TRUE : PETSC_FALSE))
+    if (KSPSetTolerances(ksp, o->tolerance, 0.0, PETSC_DEFAULT, o->max_iter) ||
+        KSPSetInitialGuessNonzero(ksp, o->warm_start ? PETSC_TRUE : PETSC_FALSE))
         lub_fatal_run("PETSc: KSPSetTolerances failed");
     for (int k = 0; k < nrhs; k++) {
         lub_solve_result *r = &res[k];
@@ -367,7 +405,7 @@ lub_solve_status lub_petsc_solve(lub_petsc *s, const lub_csr *A, int nrhs, const
             if (o->warm_start && s->dist) {
                 r->residual0 = NAN;
                 if (!VecPlaceArray(s->b, b[k]) && !VecPlaceArray(s->x, x[k]))
-                    r->residual0 = distributed_residual(s, bn);
+                    r->residual0 = distributed_residual(s, M, bn);
                 VecResetArray(s->b);
                 VecResetArray(s->x);
             } else if (o->warm_start) {
@@ -380,14 +418,14 @@ lub_solve_status lub_petsc_solve(lub_petsc *s, const lub_csr *A, int nrhs, const
             }
             /* the caller's arrays in PETSc's vectors, no copy */
             if (VecPlaceArray(s->b, b[k]) || VecPlaceArray(s->x, x[k]) ||
-                KSPSolve(s->ksp, s->b, s->x) || KSPGetConvergedReason(s->ksp, &why) ||
-                KSPGetIterationNumber(s->ksp, &its))
+                KSPSolve(ksp, s->b, s->x) || KSPGetConvergedReason(ksp, &why) ||
+                KSPGetIterationNumber(ksp, &its))
                 why = KSP_DIVERGED_PC_FAILED;
             r->iterations = (int)its;
             r->status = reason_status(why);
             /* the true residual, as the other solvers report it */
             if (s->dist) {
-                r->residual = distributed_residual(s, bn);
+                r->residual = distributed_residual(s, M, bn);
             } else {
                 lub_csr_spmv(A, x[k], s->r);
                 double rn = 0.0;
@@ -402,6 +440,86 @@ lub_solve_status lub_petsc_solve(lub_petsc *s, const lub_csr *A, int nrhs, const
         if (r->status > worst) worst = r->status;
     }
     return worst;
+}
+
+lub_solve_status lub_petsc_solve(lub_petsc *s, const lub_csr *A, int nrhs, const double *const *b,
+                                 double *const *x, const lub_pcg_options *o, lub_solve_result *res)
+{
+    if (!s->ready || s->As != A || s->stamp != A->stamp)
+        lub_bug("lub_petsc_solve without a set-up of this matrix");
+    return ksp_solve(s, s->ksp, s->A, A, nrhs, b, x, o, res);
+}
+
+/* B into PETSc (a matrix of its own, remade when its pattern changes) and its BiCGStab with
+ * its own preconditioner built from s->A (the pc of the options: set up from A, not B). */
+static int other_setup(lub_petsc *s, const lub_csr *B)
+{
+    sorted_rows(B, &s->bgcol, &s->bperm, &s->bgval, &s->bg_cap);
+    const int N = s->dist ? B->nglobal : B->n;
+    int same = s->B && s->bn == B->n && s->bnnz == B->nnz &&
+               !memcmp(s->bptr, B->row_ptr, (size_t)(B->n + 1) * sizeof *s->bptr) &&
+               !memcmp(s->bcol, s->bgcol, (size_t)B->nnz * sizeof *s->bcol);
+    if (s->dist && MPI_Allreduce(MPI_IN_PLACE, &same, 1, MPI_INT, MPI_LAND, PETSC_COMM_WORLD))
+        return -1;
+    if (same) {
+        TRY(MatUpdateMPIAIJWithArrays(s->B, B->n, B->n, N, N, B->row_ptr, s->bgcol, s->bgval));
+    } else {
+        destroy_other(s);
+        if (B->n >= s->bn_cap) {
+            free(s->bptr);
+            s->bn_cap = B->n + 1;
+            s->bptr = lub_malloc((size_t)s->bn_cap * sizeof *s->bptr);
+        }
+        if (B->nnz > s->bnnz_cap) {
+            free(s->bcol);
+            s->bnnz_cap = B->nnz;
+            s->bcol = lub_malloc((size_t)s->bnnz_cap * sizeof *s->bcol);
+        }
+        memcpy(s->bptr, B->row_ptr, (size_t)(B->n + 1) * sizeof *s->bptr);
+        memcpy(s->bcol, s->bgcol, (size_t)B->nnz * sizeof *s->bcol);
+        TRY(MatCreateMPIAIJWithArrays(s->comm, B->n, B->n, N, N, B->row_ptr, s->bgcol, s->bgval,
+                                      &s->B));
+        s->bn = B->n;
+        s->bnnz = B->nnz;
+        static const char *const pt[] = {PCHYPRE, PCGAMG, PCJACOBI, PCBJACOBI, PCSOR, PCNONE};
+        PC pc;
+        TRY(KSPCreate(s->comm, &s->kspb));
+        TRY(KSPSetType(s->kspb, KSPBCGS));
+        TRY(KSPGetPC(s->kspb, &pc));
+        TRY(PCSetType(pc, pt[s->o.pc]));
+        if (s->o.pc == LUB_PETSC_PC_HYPRE) {
+            TRY(hypre_defaults("other_"));
+            TRY(PCHYPRESetType(pc, "boomeramg"));
+        }
+        TRY(KSPSetNormType(s->kspb, KSP_NORM_UNPRECONDITIONED));
+        /* its own prefix: options meant for the symmetric solves (-ksp_type cg) stay theirs */
+        TRY(KSPSetOptionsPrefix(s->kspb, "other_"));
+        TRY(KSPSetFromOptions(s->kspb));
+    }
+    TRY(KSPSetOperators(s->kspb, s->B, s->A));
+    TRY(KSPSetUp(s->kspb));
+    return 0;
+fail:
+    return -1;
+}
+
+lub_solve_status lub_petsc_solve_other(lub_petsc *s, const lub_csr *B, int nrhs,
+                                       const double *const *b, double *const *x,
+                                       const lub_pcg_options *o, lub_solve_result *res)
+{
+    if (!s->ready || !s->A) lub_bug("lub_petsc_solve_other without a set-up");
+    if (B->n != s->n || (B->colmap != NULL) != s->dist || (s->dist && B->nglobal != s->nglobal))
+        lub_bug("lub_petsc_solve_other: B (%d rows) is not on A's rows (%d)", B->n, s->n);
+    if (other_setup(s, B)) {
+        destroy_other(s);
+        for (int k = 0; k < nrhs; k++) {
+            memset(&res[k], 0, sizeof res[k]);
+            res[k].column = -1;
+            res[k].status = LUB_SOLVE_FAILED;
+        }
+        return LUB_SOLVE_FAILED;
+    }
+    return ksp_solve(s, s->kspb, s->B, B, nrhs, b, x, o, res);
 }
 
 #endif

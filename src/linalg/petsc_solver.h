@@ -81,4 +81,13 @@ lub_solve_status lub_petsc_setup(lub_petsc *s, const lub_csr *A, const lub_pcg_o
 lub_solve_status lub_petsc_solve(lub_petsc *s, const lub_csr *A, int nrhs, const double *const *b,
                                  double *const *x, const lub_pcg_options *o, lub_solve_result *res);
 
+/* Solve B x_k = b_k, k < nrhs, by BiCGStab preconditioned by the preconditioner (the
+ * configured pc, e.g. BoomerAMG) of the matrix A of the last lub_petsc_setup: B is another
+ * operator on the same rows and columns (distributed as A is), e.g. a nonsymmetric LSMPS
+ * Laplacian whose standard counterpart is A (mps/step.c).  Tolerance, maxIter, warm start of
+ * o; res[k] with the true residual of B.  Returns the worst status. */
+lub_solve_status lub_petsc_solve_other(lub_petsc *s, const lub_csr *B, int nrhs,
+                                       const double *const *b, double *const *x,
+                                       const lub_pcg_options *o, lub_solve_result *res);
+
 #endif

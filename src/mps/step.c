@@ -297,9 +297,7 @@ static void grow_slab(void *ctx, size_t n, const char *what)
 
 void lub_mps_set_parallel(lub_mps *m, lub_par *d)
 {
-    if (m->fixed || LUB_LAPLACIAN_FITTED(m->c.lap_pressure) ||
-        LUB_LAPLACIAN_FITTED(m->c.lap_viscosity))
-        lub_bug("lub_mps_set_parallel: given particles or an LSMPS Laplacian (not parallel)");
+    if (m->fixed) lub_bug("lub_mps_set_parallel: given particles (not parallel)");
     m->par = d;
     d->grow = grow_slab;
     d->grow_ctx = m;
@@ -573,7 +571,8 @@ static void surrogate_apply(void *ctx, const double *r, double *z)
 }
 
 /* Solve A2 x_k = b_k (k < nrhs) by BiCGStab preconditioned with the solver s set up on the
- * standard matrix A; res[k] per right-hand side; returns the worst status. */
+ * standard matrix A; res[k] per right-hand side; returns the worst status.  With PETSc (and
+ * so on several ranks) PETSc's BiCGStab with s's preconditioner (BoomerAMG) of A. */
 static lub_solve_status lsmps_solve(lub_mps *m, lub_linsolver *s, int nrhs, double *const *b,
                                     double *const *x, lub_solve_result *res)
 {
@@ -583,6 +582,9 @@ static lub_solve_status lsmps_solve(lub_mps *m, lub_linsolver *s, int nrhs, doub
         for (int k = 0; k < nrhs; k++) res[k] = sr;
         return worst;
     }
+    if (s->o.kind == LUB_LINSOLVER_PETSC)
+        return lub_petsc_solve_other(s->petsc, &m->A2, nrhs, (const double *const *)b, x,
+                                     &s->o.pcg, res);
     surrogate g = {s, &m->A};
     for (int k = 0; k < nrhs; k++) {
         lub_solve_status st = lub_bicgstab_solve(
@@ -718,6 +720,7 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
             lsmps_coefficients(m, m->c.lap_viscosity, m->c.surf_viscosity ? &bc : NULL);
             const double h = 0.5 * dt * m->c.nu;
             lub_csr_begin(&m->A2, nf);
+            if (m->par) lub_csr_set_distributed(&m->A2, m->A.ncols, m->colmap, m->A.nglobal);
             for (int r = 0; r < nf; r++)
                 lub_csr_set_row_length(&m->A2, r, lub_csr_row_length(&m->A, r));
             lub_csr_alloc(&m->A2);
@@ -1268,6 +1271,7 @@ assemble:
         if (m->c.surf_pressure) surface_rows(m, 1);
         lsmps_coefficients(m, m->c.lap_pressure, m->c.surf_pressure ? &bc : NULL);
         lub_csr_begin(&m->A2, nu);
+        if (m->par) lub_csr_set_distributed(&m->A2, m->A.ncols, m->colmap, m->A.nglobal);
         for (int r = 0; r < nu; r++)
             lub_csr_set_row_length(&m->A2, r, lub_csr_row_length(&m->A, r));
         lub_csr_alloc(&m->A2);

@@ -85,12 +85,6 @@ void lubfoam_parallel_capacity(lubfoam_run *r, const lub_mps_config *cfg)
                   sc->models_path, sc->fluid->name);
     if (r->P.nlevels != 1)
         lub_fatal("%s: resolution levels do not run in parallel yet", sc->models_path);
-    if (LUB_LAPLACIAN_FITTED(cfg->lap_pressure) || LUB_LAPLACIAN_FITTED(cfg->lap_viscosity))
-        lub_fatal(
-            "%s/system/schemes.yaml: the LSMPS Laplacians (laplacian: lsmps, "
-            "lsmpsStabilized) do not run in parallel yet (their BiCGStab solve is serial): use "
-            "laplacian: standard",
-            r->cs.root);
     const int implicit = cfg->viscosity == LUB_VISCOSITY_CN;
     const int p_bad = cfg->p_solver.kind != LUB_LINSOLVER_PETSC;
     if (p_bad || (implicit && cfg->v_solver.kind != LUB_LINSOLVER_PETSC))
