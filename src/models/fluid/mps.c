@@ -54,6 +54,17 @@ static void mps_header(const lub_mps *m)
                 : m->c.viscosity == LUB_VISCOSITY_EXPLICIT ? "explicit"
                                                            : "crankNicolson",
                 order);
+    /* the Laplacians and the walls' viscous representation decide a film's accuracy
+     * (tutorials/README.md, "The slender wedge and the choice of Laplacian"): said here */
+    static const char *const lap[] = {"standard", "lsmps", "lsmpsStabilized"};
+    static const char *const dummy[] = {"wall", "mirror", "extrapolate", "flux"};
+    const int fv = LUB_LAPLACIAN_FITTED(m->c.lap_viscosity),
+              fp = LUB_LAPLACIAN_FITTED(m->c.lap_pressure);
+    lub_message("Laplacians: viscosity %s%s, pressure %s%s; dummyVelocity %s",
+                lap[m->c.lap_viscosity],
+                fv && m->c.surf_viscosity ? " (stress-free surface row)" : "",
+                lap[m->c.lap_pressure], fp && m->c.surf_pressure ? " (surface point row)" : "",
+                dummy[m->c.dummy_velocity]);
     lub_message("Solvers: p %s; U %s", ps, vs);
 }
 
