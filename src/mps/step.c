@@ -583,8 +583,8 @@ static lub_solve_status lsmps_solve(lub_mps *m, lub_linsolver *s, int nrhs, doub
         return worst;
     }
     if (s->o.kind == LUB_LINSOLVER_PETSC)
-        return lub_petsc_solve_other(s->petsc, &m->A2, nrhs, (const double *const *)b, x,
-                                     &s->o.pcg, res);
+        return lub_petsc_solve_other(s->petsc, &m->A2, nrhs, (const double *const *)b, x, &s->o.pcg,
+                                     res);
     surrogate g = {s, &m->A};
     for (int k = 0; k < nrhs; k++) {
         lub_solve_status st = lub_bicgstab_solve(

@@ -60,11 +60,10 @@ static void mps_header(const lub_mps *m)
     static const char *const dummy[] = {"wall", "mirror", "extrapolate", "flux"};
     const int fv = LUB_LAPLACIAN_FITTED(m->c.lap_viscosity),
               fp = LUB_LAPLACIAN_FITTED(m->c.lap_pressure);
-    lub_message("Laplacians: viscosity %s%s, pressure %s%s; dummyVelocity %s",
-                lap[m->c.lap_viscosity],
-                fv && m->c.surf_viscosity ? " (stress-free surface row)" : "",
-                lap[m->c.lap_pressure], fp && m->c.surf_pressure ? " (surface point row)" : "",
-                dummy[m->c.dummy_velocity]);
+    lub_message(
+        "Laplacians: viscosity %s%s, pressure %s%s; dummyVelocity %s", lap[m->c.lap_viscosity],
+        fv && m->c.surf_viscosity ? " (stress-free surface row)" : "", lap[m->c.lap_pressure],
+        fp && m->c.surf_pressure ? " (surface point row)" : "", dummy[m->c.dummy_velocity]);
     lub_message("Solvers: p %s; U %s", ps, vs);
 }
 
