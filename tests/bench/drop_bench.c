@@ -32,8 +32,8 @@
  * profile.  The pair sums run over the library's cell-linked neighbour lists (pairs_build);
  * the last line gives the cost: steps, wall time and its phases (the library's step and the
  * diagnostics).  The library's step is the cost: in 3-D a drop of 7,000 particles takes
- * 0.6-1.2 s per step on one thread, a reading of the diagnostics (every LUB_EVERY steps)
- * 0.35 s (about 2 s over all pairs).
+ * 0.6-1.6 s per step on one thread, a reading of the diagnostics (every LUB_EVERY steps)
+ * 0.1-0.35 s (about 2 s over all pairs).
  */
 #include <math.h>
 #include <stdio.h>
