@@ -13,6 +13,11 @@
  *     build/bench/drop_bench slab DIM T         a slab T l0 thick, periodic across (LUB_WIDTH
  *                                               l0, 20): its tension (the force across a
  *                                               normal cut) and energy per area
+ *     build/bench/drop_bench check DIM R0       the diagnostic sums below from the neighbour
+ *                                               lists against the same over all pairs, after
+ *                                               LUB_ANNEAL (20) steps of kicks: PASS/FAIL
+ *                                               lines, exit 1 on a failure
+ *                                               (tests/cases/dropBench runs it)
  *
  * l0 = 0.1 mm, rho 1000; environment: LUB_STEPS (steps of LUB_DT, 2e-5 s), LUB_NU (1e-4),
  * LUB_KAPPA (3e3), LUB_LAMBDA (1), LUB_SIGMA (0.03), LUB_AMP (the mode-2 amplitude eps, 0.1),
@@ -24,7 +29,11 @@
  * x, y, P, the virial pressure of each particle at the end, in l0 and dp).  The laplace drop's
  * inside pressure is read three ways: the mean P of (K-7a), the force across the two cuts, and the
  * virial (the trace of the pair forces' stress) of the interior particles; at the end a radial
- * profile.  The pair sums are over all pairs: slow beyond a few thousand particles.
+ * profile.  The pair sums run over the library's cell-linked neighbour lists (pairs_build);
+ * the last line gives the cost: steps, wall time and its phases (the library's step and the
+ * diagnostics).  The library's step is the cost: in 3-D a drop of 7,000 particles takes
+ * 0.6-1.6 s per step on one thread, a reading of the diagnostics (every LUB_EVERY steps)
+ * 0.1-0.35 s (about 2 s over all pairs).
  */
 #include <math.h>
 #include <stdio.h>
@@ -32,6 +41,7 @@
 #include <string.h>
 
 #include "core/error.h"
+#include "core/timer.h"
 #include "io/dict.h"
 #include "models/fluid/mph.h"
 #include "models/model.h"
@@ -48,12 +58,16 @@ typedef struct {
     lub_model model;
     lub_scene scene;
     lub_dict *dict;
+    double seconds; /* in the model's forces (inside lub_mph_step's assembly phase) */
 } driver;
 
 static int hook(void *ctx, const lub_mps *m, double *const acc[3])
 {
     driver *d = ctx;
-    return d->model.type->particle_forces(&d->model, m, acc);
+    const double t0 = lub_wtime();
+    const int r = d->model.type->particle_forces(&d->model, m, acc);
+    d->seconds += lub_wtime() - t0;
+    return r;
 }
 
 /* ---- the mechanical stress across a cut, from the pair forces ------------------------------
@@ -82,13 +96,72 @@ typedef struct {
     double Lx;
 } stmodel;
 
-static void cut_stress(const stmodel *M, const lub_particles *P, int ax, int tg, double xc,
-                       const double centre[3], double rc, double out[3]);
+/* The pairs of the diagnostic sums below (every pair closer than h_s): the library's
+ * cell-linked lists (src/mps/neighbours.h), built afresh for the particles' current positions
+ * by pairs_build, or every j of every i (all = 1: the reference that `drop_bench check`
+ * compares the lists with).  A list holds the pairs within 1.01 h_s and each sum keeps those
+ * that sep() puts within h_s: the two paths sum the same terms, computed the same way, and
+ * differ only in the order of the summation.  The all-pairs sums cost O(N^2): a 3-D drop of
+ * 7,000 particles spent seconds per reading on them. */
+typedef struct {
+    lub_neighbours nb;
+    int all, ready;
+    size_t n;
+} pairs;
+
+static void pairs_build(pairs *pp, const stmodel *M, const lub_particles *P)
+{
+    pp->n = P->n;
+    if (pp->all) return;
+    /* x (and z in 3-D) periodic with the period Lx where Lx > 0; elsewhere the particles'
+     * bounding box (particles outside would be clamped into the boundary cells: still exact) */
+    double lo[3] = {0, 0, 0}, hi[3] = {M->l0, M->l0, M->l0};
+    int periodic[3] = {0, 0, 0};
+    for (int q = 0; q < M->dim; q++) {
+        if (q != 1 && M->Lx > 0) {
+            periodic[q] = 1, hi[q] = M->Lx;
+            continue;
+        }
+        lo[q] = INFINITY, hi[q] = -INFINITY;
+        for (size_t i = 0; i < P->n; i++)
+            lo[q] = fmin(lo[q], P->x[q][i]), hi[q] = fmax(hi[q], P->x[q][i]);
+        lo[q] -= M->l0, hi[q] += M->l0;
+    }
+    if (!pp->ready)
+        lub_neighbours_init(&pp->nb, M->dim, M->hs, 0.01, lo, hi, periodic);
+    else
+        lub_neighbours_set_box(&pp->nb, lo, hi, periodic);
+    pp->ready = 1;
+    lub_neighbours_build(&pp->nb, P->n, P->x);
+}
+
+static void pairs_free(pairs *pp)
+{
+    if (pp->ready) lub_neighbours_free(&pp->nb);
+    pp->ready = 0;
+}
+
+/* the candidates j of particle i: entries q from pairs_begin to pairs_end, j = pairs_j */
+static size_t pairs_begin(const pairs *pp, size_t i)
+{
+    return pp->all ? 0 : pp->nb.start[i];
+}
+static size_t pairs_end(const pairs *pp, size_t i)
+{
+    return pp->all ? pp->n : pp->nb.end[i];
+}
+static size_t pairs_j(const pairs *pp, size_t q)
+{
+    return pp->all ? q : pp->nb.j[q];
+}
+
+static void cut_stress(const stmodel *M, const lub_particles *P, const pairs *pp, int ax, int tg,
+                       double xc, const double centre[3], double rc, double out[3]);
 
 /* The model's coefficient a (methods.md §9), found here again: the flat interface of a
  * lattice slab (16 rows, periodic over 10 l0 across) pulls sigma, its tension per unit a
  * from the force across a cut normal to it (cut_stress). */
-static double st_calibrate(stmodel *M, double sigma)
+static double st_calibrate(stmodel *M, double sigma, int all)
 {
     lub_particles S;
     lub_particles_init(&S, M->dim, 1);
@@ -101,13 +174,16 @@ static double st_calibrate(stmodel *M, double sigma)
     const double Lx = M->Lx, ctr[3] = {0, 0, 0};
     double o[3];
     M->Lx = 10 * M->l0, M->a = 1.0;
-    cut_stress(M, &S, 0, 1, 4.5 * M->l0, ctr, 0, o);
+    pairs pp = {.all = all};
+    pairs_build(&pp, M, &S);
+    cut_stress(M, &S, &pp, 0, 1, 4.5 * M->l0, ctr, 0, o);
     M->Lx = Lx;
+    pairs_free(&pp);
     lub_particles_free(&S);
     return sigma / (-0.5 * o[0]);
 }
 
-static void st_setup(stmodel *M, int dim, double l0, double sigma, double Lx)
+static void st_setup(stmodel *M, int dim, double l0, double sigma, double Lx, int all)
 {
     M->dim = dim, M->l0 = l0, M->hs = 3.5 * l0, M->Lx = Lx;
     M->k = dim == 2 ? 0.350778153 : 0.326976006;
@@ -124,7 +200,7 @@ static void st_setup(stmodel *M, int dim, double l0, double sigma, double Lx)
                 const double r = l0 * sqrt((double)(x * x + y * y + z * z));
                 if (r > 0) M->n0a += k_wa(dim, l0, M->hs, r);
             }
-    M->a = st_calibrate(M, sigma);
+    M->a = st_calibrate(M, sigma, all);
 }
 
 static double sep(const stmodel *M, const lub_particles *P, size_t i, size_t j, double r[3])
@@ -139,15 +215,17 @@ static double sep(const stmodel *M, const lub_particles *P, size_t i, size_t j, 
 }
 
 /* The attractive number density n^a_i and the vector chi_i of (K-8) of every particle, over
- * all pairs within h_s (allocated here; the caller frees them) */
-static void densities(const stmodel *M, const lub_particles *P, double **na_out, double *chi[3])
+ * the pairs within h_s (allocated here; the caller frees them) */
+static void densities(const stmodel *M, const lub_particles *P, const pairs *pp, double **na_out,
+                      double *chi[3])
 {
     const int dim = M->dim;
     const size_t n = P->n;
     double *na = lub_calloc(n, sizeof(double));
     for (int q = 0; q < 3; q++) chi[q] = lub_calloc(n, sizeof(double));
     for (size_t i = 0; i < n; i++)
-        for (size_t j = 0; j < n; j++) {
+        for (size_t q = pairs_begin(pp, i); q < pairs_end(pp, i); q++) {
+            const size_t j = pairs_j(pp, q);
             double r[3];
             const double d = sep(M, P, i, j, r);
             if (j == i || !(d < M->hs)) continue;
@@ -162,20 +240,21 @@ static void densities(const stmodel *M, const lub_particles *P, double **na_out,
  * crossing points within rc of centre (rc <= 0: anywhere), that the side above exerts... on
  * the side above from below: returned along ax (normal: + pushes apart, a pressure) and
  * along tg (tangential) in out[0], out[1]; and the same from the P pairs alone in out[2]. */
-static void cut_stress(const stmodel *M, const lub_particles *P, int ax, int tg, double xc,
-                       const double centre[3], double rc, double out[3])
+static void cut_stress(const stmodel *M, const lub_particles *P, const pairs *pp, int ax, int tg,
+                       double xc, const double centre[3], double rc, double out[3])
 {
     const int dim = M->dim;
     const size_t n = P->n;
     double *na, *chi[3];
-    densities(M, P, &na, chi);
+    densities(M, P, pp, &na, chi);
     for (size_t i = 0; i < n; i++) na[i] = fmin(na[i] - M->n0a, 0.0);
     const double dA = dim == 2 ? M->l0 * M->l0 : M->l0 * M->l0 * M->l0;
     const double hp = LUB_MPH_HP * M->l0, ak2 = M->a * M->k * M->k * M->ch;
     double Fn = 0, Ft = 0, Fp = 0;
     for (size_t i = 0; i < n; i++) {
         if (!(P->x[ax][i] < xc)) continue; /* i below, j above */
-        for (size_t j = 0; j < n; j++) {
+        for (size_t q = pairs_begin(pp, i); q < pairs_end(pp, i); q++) {
+            const size_t j = pairs_j(pp, q);
             double r[3];
             const double d = sep(M, P, i, j, r);
             if (j == i || !(d < M->hs) || !(P->x[ax][i] + r[ax] >= xc)) continue;
@@ -197,13 +276,13 @@ static void cut_stress(const stmodel *M, const lub_particles *P, int ax, int tg,
                 vr += v[q] * -r[q];
             }
             const double cpp = M->a * (na[i] + na[j]) * k_dwa(dim, M->l0, M->hs, d);
-            const double pp = d < hp ? (P->p[i] + P->p[j]) * lub_mph_dw(dim, M->l0, hp, d) : 0;
+            const double pr = d < hp ? (P->p[i] + P->p[j]) * lub_mph_dw(dim, M->l0, hp, d) : 0;
             const double wg = lub_mph_w(dim, M->l0, M->hs, d);
             const double dwg = lub_mph_dw(dim, M->l0, M->hs, d);
             double f[3];
             for (int q = 0; q < 3; q++)
-                f[q] = dA * ((cpp + pp) * e[q] - ak2 * (wg * v[q] + vr * e[q] * dwg));
-            Fn += f[ax], Ft += f[tg], Fp += dA * pp * e[ax];
+                f[q] = dA * ((cpp + pr) * e[q] - ak2 * (wg * v[q] + vr * e[q] * dwg));
+            Fn += f[ax], Ft += f[tg], Fp += dA * pr * e[ax];
         }
     }
     /* the whole cut: per length in 2-D, and in 3-D per length of the slab's period along z
@@ -221,13 +300,13 @@ static void cut_stress(const stmodel *M, const lub_particles *P, int ax, int tg,
  * pairs, at rest), -(1/(2 d dV)) sum_j r_ij . f_ij per particle i (f_ij on i from j), its
  * mean over those particles; out[0] all pairs, out[1] the P pairs alone, out[2] the mean
  * of P, out[3] the count. */
-static void virial(const stmodel *M, const lub_particles *P, const double centre[3], double rc,
-                   double out[4], double *wi, double *nai)
+static void virial(const stmodel *M, const lub_particles *P, const pairs *pp,
+                   const double centre[3], double rc, double out[4], double *wi, double *nai)
 {
     const int dim = M->dim;
     const size_t n = P->n;
     double *na, *chi[3];
-    densities(M, P, &na, chi);
+    densities(M, P, pp, &na, chi);
     for (size_t i = 0; i < n; i++) {
         if (nai) nai[i] = na[i] / M->n0a;
         na[i] = fmin(na[i] - M->n0a, 0.0);
@@ -242,7 +321,8 @@ static void virial(const stmodel *M, const lub_particles *P, const double centre
         if (off2 > rc * rc) continue;
         cnt++, sP += P->p[i];
         const double sa0 = sa;
-        for (size_t j = 0; j < n; j++) {
+        for (size_t q = pairs_begin(pp, i); q < pairs_end(pp, i); q++) {
+            const size_t j = pairs_j(pp, q);
             double r[3];
             const double d = sep(M, P, i, j, r);
             if (j == i || !(d < M->hs)) continue;
@@ -254,13 +334,13 @@ static void virial(const stmodel *M, const lub_particles *P, const double centre
                 vr += v[q] * r[q];
             }
             const double cpp = M->a * (na[i] + na[j]) * k_dwa(dim, M->l0, M->hs, d);
-            const double pp = d < hp ? (P->p[i] + P->p[j]) * lub_mph_dw(dim, M->l0, hp, d) : 0;
+            const double pr = d < hp ? (P->p[i] + P->p[j]) * lub_mph_dw(dim, M->l0, hp, d) : 0;
             const double wg = lub_mph_w(dim, M->l0, M->hs, d);
             const double dwg = lub_mph_dw(dim, M->l0, M->hs, d);
             double rf = 0, rfp = 0;
             for (int q = 0; q < dim; q++) {
-                rf += r[q] * dA * ((cpp + pp) * e[q] - ak2 * (wg * v[q] + vr * e[q] * dwg));
-                rfp += r[q] * dA * pp * e[q];
+                rf += r[q] * dA * ((cpp + pr) * e[q] - ak2 * (wg * v[q] + vr * e[q] * dwg));
+                rfp += r[q] * dA * pr * e[q];
             }
             sa += -rf / (2 * dim * dA), sp += -rfp / (2 * dim * dA);
         }
@@ -273,8 +353,9 @@ static void virial(const stmodel *M, const lub_particles *P, const double centre
 }
 
 /* The surface potential (K-7b) and the elastic energy sum (kappa/2) max(n - n0, 0)^2 dV of
- * every particle (per unit depth in 2-D), over all pairs. */
-static void energies(const stmodel *M, const lub_particles *P, double kappa, double *Vs, double *Ve)
+ * every particle (per unit depth in 2-D), over the pairs within h_s. */
+static void energies(const stmodel *M, const lub_particles *P, const pairs *pp, double kappa,
+                     double *Vs, double *Ve)
 {
     const int dim = M->dim;
     const double hp = LUB_MPH_HP * M->l0, n0 = lub_mph_n0(dim, M->l0);
@@ -282,7 +363,8 @@ static void energies(const stmodel *M, const lub_particles *P, double kappa, dou
     *Vs = *Ve = 0;
     for (size_t i = 0; i < P->n; i++) {
         double na = 0, np = 0, chi[3] = {0, 0, 0};
-        for (size_t j = 0; j < P->n; j++) {
+        for (size_t q = pairs_begin(pp, i); q < pairs_end(pp, i); q++) {
+            const size_t j = pairs_j(pp, q);
             double r[3];
             const double d = sep(M, P, i, j, r);
             if (j == i || !(d < M->hs)) continue;
@@ -298,6 +380,92 @@ static void energies(const stmodel *M, const lub_particles *P, double kappa, dou
     }
 }
 
+/* The number density n_i of the fluid's pressure kernel (h_p) of particle i. */
+static double number_density(const stmodel *M, const lub_particles *P, const pairs *pp, size_t i)
+{
+    const double hp = LUB_MPH_HP * M->l0;
+    double np = 0;
+    for (size_t q = pairs_begin(pp, i); q < pairs_end(pp, i); q++) {
+        const size_t j = pairs_j(pp, q);
+        double r[3];
+        const double d = sep(M, P, i, j, r);
+        if (j != i && d < hp) np += lub_mph_w(M->dim, M->l0, hp, d);
+    }
+    return np;
+}
+
+/* drop_bench check: every diagnostic sum from the lists against the same over all pairs, on
+ * the drop as it is (annealed: off the lattice), and the calibration's a on its periodic
+ * slab.  Differences relative to each quantity's scale (n0^a; the largest |chi|; dp; the
+ * energies and a themselves); tol: the round-off of a different summation order.  Returns
+ * the number of failures. */
+static int check_pairs(const stmodel *M, const stmodel *Ma, const lub_particles *P, double kappa,
+                       double dp, double rin)
+{
+    const double tol = 1e-12;
+    int fails = 0;
+    pairs pl = {.all = 0}, pa = {.all = 1};
+    pairs_build(&pl, M, P), pairs_build(&pa, Ma, P);
+    const size_t n = P->n;
+    double cx[3] = {0, 0, 0};
+    for (size_t i = 0; i < n; i++)
+        for (int q = 0; q < M->dim; q++) cx[q] += P->x[q][i] / n;
+    double e[8] = {0}, *na[2], *chi[2][3];
+    const char *what[8] = {"the calibration's a (relative)",
+                           "n^a (over n0^a)",
+                           "chi (over its largest)",
+                           "the cuts' stress (over dp)",
+                           "the virial, interior and per particle (over dp)",
+                           "the energies (relative)",
+                           "n (over n0)",
+                           ""};
+    e[0] = fabs(M->a - Ma->a) / Ma->a;
+    densities(M, P, &pl, &na[0], chi[0]);
+    densities(Ma, P, &pa, &na[1], chi[1]);
+    double chimax = 0;
+    for (size_t i = 0; i < n; i++)
+        for (int q = 0; q < M->dim; q++) chimax = fmax(chimax, fabs(chi[1][q][i]));
+    for (size_t i = 0; i < n; i++) {
+        e[1] = fmax(e[1], fabs(na[0][i] - na[1][i]) / M->n0a);
+        for (int q = 0; q < M->dim; q++)
+            e[2] = fmax(e[2], fabs(chi[0][q][i] - chi[1][q][i]) / chimax);
+    }
+    for (int ax = 0; ax < M->dim; ax++) {
+        double o[2][3];
+        cut_stress(M, P, &pl, ax, (ax + 1) % M->dim, cx[ax], cx, rin, o[0]);
+        cut_stress(Ma, P, &pa, ax, (ax + 1) % M->dim, cx[ax], cx, rin, o[1]);
+        for (int k = 0; k < 3; k++) e[3] = fmax(e[3], fabs(o[0][k] - o[1][k]) / dp);
+    }
+    double v[2][4], *w[2];
+    for (int k = 0; k < 2; k++) w[k] = lub_calloc(n, sizeof(double));
+    virial(M, P, &pl, cx, rin, v[0], w[0], NULL);
+    virial(Ma, P, &pa, cx, rin, v[1], w[1], NULL);
+    for (int k = 0; k < 3; k++) e[4] = fmax(e[4], fabs(v[0][k] - v[1][k]) / dp);
+    if (v[0][3] != v[1][3]) e[4] = INFINITY;
+    /* the per-particle sums are running totals (wi = the particle's share): compared as such */
+    for (size_t i = 0; i < n; i++) e[4] = fmax(e[4], fabs(w[0][i] - w[1][i]) / dp);
+    double Vs[2], Ve[2];
+    energies(M, P, &pl, kappa, &Vs[0], &Ve[0]);
+    energies(Ma, P, &pa, kappa, &Vs[1], &Ve[1]);
+    e[5] = fmax(fabs(Vs[0] - Vs[1]) / fabs(Vs[1]), fabs(Ve[0] - Ve[1]) / fmax(fabs(Ve[1]), 1e-300));
+    const double n0 = lub_mph_n0(M->dim, M->l0);
+    for (size_t i = 0; i < n; i++)
+        e[6] = fmax(e[6], fabs(number_density(M, P, &pl, i) - number_density(Ma, P, &pa, i)) / n0);
+    for (int k = 0; k < 7; k++) {
+        printf("%s %d-D drop of %zu particles: %s, lists against all pairs: %.2e (tol %.0e)\n",
+               e[k] <= tol ? "PASS" : "FAIL", M->dim, n, what[k], e[k], tol);
+        fails += !(e[k] <= tol);
+    }
+    printf("  (%zu pairs within 1.01 h_s in the lists; the interior's virial %.6f dp)\n",
+           pl.nb.npairs, v[0][0] / dp);
+    for (int k = 0; k < 2; k++) {
+        free(na[k]), free(w[k]);
+        for (int q = 0; q < 3; q++) free(chi[k][q]);
+    }
+    pairs_free(&pl);
+    return fails;
+}
+
 static double env(const char *name, double def)
 {
     const char *e = getenv(name);
@@ -307,10 +475,12 @@ static double env(const char *name, double def)
 int main(int argc, char **argv)
 {
     if (argc < 4) {
-        fprintf(stderr, "usage: drop_bench laplace|oscillate DIM R0\n");
+        fprintf(stderr,
+                "usage: drop_bench laplace|oscillate|check DIM R0, drop_bench slab DIM T\n");
         return 1;
     }
     const int osc = strcmp(argv[1], "oscillate") == 0, dim = atoi(argv[2]);
+    const int chk = strcmp(argv[1], "check") == 0;
     const int slab = strcmp(argv[1], "slab") == 0, W = (int)env("LUB_WIDTH", 20);
     const double R0 = atof(argv[3]);
     const double l0 = 1e-4, rho = 1000, sigma = env("LUB_SIGMA", 0.03);
@@ -379,7 +549,9 @@ int main(int argc, char **argv)
         periodic[0] = 1, periodic[2] = dim == 3;
     }
     stmodel M;
-    st_setup(&M, dim, l0, sigma, slab ? W * l0 : 0.0);
+    st_setup(&M, dim, l0, sigma, slab ? W * l0 : 0.0, 0);
+    pairs pp = {.all = 0};
+    double tdiag = 0, t0 = lub_wtime();
     lub_mps m;
     lub_mps_init(&m, &P, &c, lo, hi, periodic);
     d.scene.nlevels = 1, d.scene.level[0] = &m;
@@ -393,7 +565,7 @@ int main(int argc, char **argv)
     const double T = 2 * M_PI / sqrt(omega2);
     /* LUB_ANNEAL=N steps with random velocity kicks (zero mean, standard deviation LUB_NOISE
      * m/s per step falling linearly to 0): the drop shaken out of its first packing */
-    const long nanneal = (long)env("LUB_ANNEAL", 0);
+    const long nanneal = (long)env("LUB_ANNEAL", chk ? 20 : 0);
     const double noise = env("LUB_NOISE", 0.01);
     srand((unsigned)env("LUB_SEED", 12345));
     if (osc && nanneal > 0) /* annealed with the relaxation's viscosities, as it settles */
@@ -480,6 +652,18 @@ int main(int argc, char **argv)
             }
         m.c.nu = nu, m.c.bulk_viscosity = lambda;
     }
+    if (chk) {
+        stmodel Ma;
+        st_setup(&Ma, dim, l0, sigma, 0.0, 1);
+        printf("check %d-D: %zu particles after %ld steps of kicks\n", dim, P.n, nanneal);
+        const int fails = check_pairs(&M, &Ma, &P, kappa, dp, rin);
+        lub_mps_free(&m);
+        d.model.type->free(&d.model);
+        free(d.model.state);
+        lub_dict_free(d.dict);
+        lub_particles_free(&P);
+        return fails ? 1 : 0;
+    }
     /* the settled drop's own <x^2> - <y^2> (a jammed packing is not quite round): the
      * oscillation is measured about it, or its crossings alternate unevenly and the extremes
      * of one side stand higher than the other's as the amplitude decays */
@@ -510,13 +694,14 @@ int main(int argc, char **argv)
     if (slab) { /* the tension of the lattice slab as built (P = 0) */
         double o[3];
         const double ctr[3] = {0, 0, 0};
-        cut_stress(&M, &P, 0, 1, 0.5 * l0 * (W / 2 - 0.5) + 0.25 * l0 * 0, ctr, 0, o);
+        pairs_build(&pp, &M, &P);
+        cut_stress(&M, &P, &pp, 0, 1, 0.5 * l0 * (W / 2 - 0.5) + 0.25 * l0 * 0, ctr, 0, o);
         printf("lattice slab: tension %.5g N/m = %.4f sigma (a %.6g Pa; Kondo's energy "
                "calibration, a %.6g Pa, would pull %.4f sigma)\n",
                -0.5 * o[0], -0.5 * o[0] / sigma, M.a, M.a_energy,
                -0.5 * o[0] / sigma * M.a_energy / M.a);
         double Vs, Ve;
-        energies(&M, &P, kappa, &Vs, &Ve);
+        energies(&M, &P, &pp, kappa, &Vs, &Ve);
         const double area = dim == 2 ? 2 * W * l0 : 2 * W * W * l0 * l0;
         printf("lattice slab: energy per area %.5g = %.4f sigma (surface %.4f, elastic %.4f)\n",
                (Vs + Ve) / area, (Vs + Ve) / area / sigma, Vs / area / sigma, Ve / area / sigma);
@@ -547,6 +732,8 @@ int main(int argc, char **argv)
             Dprev = D;
         }
         if (k % every) continue;
+        const double td = lub_wtime();
+        pairs_build(&pp, &M, &P);
         double cx[3] = {0, 0, 0}, ke = 0;
         for (size_t i = 0; i < P.n; i++)
             for (int q = 0; q < dim; q++)
@@ -563,7 +750,7 @@ int main(int argc, char **argv)
         if (slab) {
             double o[3];
             const double ctr[3] = {0, 0, 0};
-            cut_stress(&M, &P, 0, 1, (W / 2 - 0.5) * l0, ctr, 0, o);
+            cut_stress(&M, &P, &pp, 0, 1, (W / 2 - 0.5) * l0, ctr, 0, o);
             double ymin = INFINITY, ymax = -INFINITY;
             for (size_t i = 0; i < P.n; i++)
                 ymin = fmin(ymin, P.x[1][i]), ymax = fmax(ymax, P.x[1][i]);
@@ -573,23 +760,24 @@ int main(int argc, char **argv)
                    sqrt(2 * ke));
             if (k > nsteps / 2) sum += -0.5 * o[0] / sigma, sumn++;
             double Vs, Ve;
-            energies(&M, &P, kappa, &Vs, &Ve);
+            energies(&M, &P, &pp, kappa, &Vs, &Ve);
             const double area = dim == 2 ? 2 * W * l0 : 2 * W * W * l0 * l0;
             printf("  energy per area %.4f sigma (surface %.4f, elastic %.4f)\n",
                    (Vs + Ve) / area / sigma, Vs / area / sigma, Ve / area / sigma);
+            tdiag += lub_wtime() - td;
             continue;
         }
         /* the mechanical pressure: the force across the interior parts of the two cuts
          * through the centroid (x and y), per length (area) */
         double o[3], o2[3];
-        cut_stress(&M, &P, 1, 0, cx[1], cx, rin, o);
-        cut_stress(&M, &P, 0, 1, cx[0], cx, rin, o2);
+        cut_stress(&M, &P, &pp, 1, 0, cx[1], cx, rin, o);
+        cut_stress(&M, &P, &pp, 0, 1, cx[0], cx, rin, o2);
         const double pm = 0.5 * (o[0] + o2[0]);
         printf("  cuts through the centre: interior pressure %.5g Pa = %.4f dp (P pairs %.4f "
                "dp)\n",
                pm, pm / dp, 0.5 * (o[2] + o2[2]) / dp);
         double vo[4];
-        virial(&M, &P, cx, rin, vo, NULL, NULL);
+        virial(&M, &P, &pp, cx, rin, vo, NULL, NULL);
         printf("  virial over the interior: %.4f dp (P pairs %.4f dp, mean P %.4f dp, %.0f "
                "particles)\n",
                vo[0] / dp, vo[1] / dp, vo[2] / dp, vo[3]);
@@ -599,14 +787,16 @@ int main(int argc, char **argv)
         printf("t %.5f: P %.5g pc %.5g sum/dp %.4f  rms u %.3g  <x2>-<y2> %.4g l0^2\n", k * dt,
                sp / cnt, sc / cnt, (sp + sc) / cnt / dp, sqrt(2 * ke), (sx - sy) / P.n / (l0 * l0));
         fflush(stdout);
+        tdiag += lub_wtime() - td;
     }
     if (!osc && !slab) { /* the radial profile at the end: bins of l0 from the centroid */
         double cx[3] = {0, 0, 0}, vo[4];
         for (size_t i = 0; i < P.n; i++)
             for (int q = 0; q < dim; q++) cx[q] += P.x[q][i] / P.n;
         double *wi = lub_calloc(P.n, sizeof(double)), *nai = lub_calloc(P.n, sizeof(double));
-        virial(&M, &P, cx, 10 * R, vo, wi, nai);
-        const double n0 = lub_mph_n0(dim, l0), hp = LUB_MPH_HP * l0;
+        pairs_build(&pp, &M, &P);
+        virial(&M, &P, &pp, cx, 10 * R, vo, wi, nai);
+        const double n0 = lub_mph_n0(dim, l0);
         const int nb = (int)(R / l0) + 3;
         printf("radial profile (r/l0, count, P/dp, virial/dp, n/n0, n^a/n0^a):\n");
         for (int b = 0; b < nb; b++) {
@@ -616,12 +806,7 @@ int main(int argc, char **argv)
                 double r2 = 0;
                 for (int q = 0; q < dim; q++) r2 += (P.x[q][i] - cx[q]) * (P.x[q][i] - cx[q]);
                 if ((int)(sqrt(r2) / l0) != b) continue;
-                double np = 0;
-                for (size_t j = 0; j < P.n; j++) {
-                    double r[3];
-                    const double dd = sep(&M, &P, i, j, r);
-                    if (j != i && dd < hp) np += lub_mph_w(dim, l0, hp, dd);
-                }
+                const double np = number_density(&M, &P, &pp, i);
                 sp += P.p[i], sv += wi[i], sn += np / n0, sa += nai[i], cnt++;
             }
             if (cnt)
@@ -664,6 +849,19 @@ int main(int argc, char **argv)
         printf("mean over the second half: P + pCohesive %.4f of dp, the mechanical pressure %.4f "
                "(cuts), %.4f (virial)\n",
                sum / sumn / dp, summ / sumn / dp, sumv / sumn / dp);
+    /* where the time went (the library's phases: src/mps/mps.h; the assembly holds n_i, the
+     * surface tension's forces and the viscous system's assembly) */
+    const double tw = lub_wtime() - t0, *ts = m.tm.seconds;
+    const long ksteps = nanneal + nrelax + nsteps;
+    if (ksteps > 0)
+        printf("cost: %ld steps of %zu particles in %.1f s, %.3g s per step (%.3g us per "
+               "particle-step); lub_mph_step: neighbours %.1f s, assembly %.1f s (the surface "
+               "tension's forces %.1f s), viscous solve %.1f s (%.1f PCG iterations per step), "
+               "divergence %.1f s, other %.1f s; the diagnostics %.1f s\n",
+               ksteps, P.n, tw, tw / ksteps, 1e6 * tw / ksteps / P.n, ts[LUB_T_NEIGHBOUR],
+               ts[LUB_T_ASSEMBLY], d.seconds, ts[LUB_T_VISCOSITY], m.iterations[1] / ksteps,
+               ts[LUB_T_GRADIENT], ts[LUB_T_OTHER], tdiag);
+    pairs_free(&pp);
     lub_mps_free(&m);
     d.model.type->free(&d.model);
     free(d.model.state);
