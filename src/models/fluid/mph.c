@@ -168,15 +168,17 @@ double lub_mph_layer_quadrature(int dim)
  * so that Bg_i M^F_i + M^W_i = -I: each fluid particle's own pressure has the isotropic
  * virial -P_i I over all its pairs (in the bulk M^W = 0, Bg = B of the divergence).  The
  * wall pairs stay central: with Bg = -M_i^-1 on them too (the fluid's fabric rotating its
- * wall pairs) a flat wall pushes a sheared film along by about 0.04 P M_xy/m0 per unit area
- * (the channel's flux rose 9% from 13 to 182 Pa), and with the bulk's B on the fluid
- * pairs and the wall pairs central the near-wall rows keep part of the friction (-6.6%).
+ * wall pairs) flat walls push a sheared film along (the jittered channel at a mean 95 Pa:
+ * +0.011 N/m over both walls, a tenth of their shear load; the flux rose 9% from 13 to 182
+ * Pa); with that B on the fluid pairs and the wall pairs central, the near-wall rows keep
+ * part of the friction (-6.6%).
  * Momentum: f_ji = -f_ij.  Angular momentum: the torque of i's pairs is the antisymmetric
  * part of Bg_i M^F_i + M^W_i = -I, none; a wall's pairs are central (fluid and rigid bodies
  * together keep it exactly, as with the plain force).  Energy: the force is no longer the
  * gradient of (K-3)'s potential (the elastic energy changes at sum_i P_i s_i dV, the force's
- * power is sum_i P_i s^g_i dV with the corrected s^g): not conserved exactly, measured in
- * tests/unit/mph_test.c.  Where M^F_i is too deficient to invert (CORR_MIN), Bg_i = I. */
+ * power is -sum_i P_i s^g_i dV with the corrected s^g): not conserved (it grows where little
+ * dissipation damps the particles: methods.md §8).  Where M^F_i is too deficient to invert
+ * (CORR_MIN), Bg_i = I. */
 
 /* m0: -M = m0 I on the lattice interior, m0 = sum_j r_j (-w_p'(r_j)) / d (l0 = 1). */
 static double lattice_m(int dim)
