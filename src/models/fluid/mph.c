@@ -443,12 +443,13 @@ static void divergence(lub_mps *m, mph_state *S, double *s)
 static inline void pair_elastic(const lub_mps *m, const mph_state *S, size_t i, size_t j,
                                 const double e[3], double dw, double f[3])
 {
-    double g[3];
-    for (int d = 0; d < 3; d++) g[d] = e[d] * dw;
     if (!S->Bg || m->P->kind[i] != LUB_FLUID || m->P->kind[j] != LUB_FLUID) {
-        for (int d = 0; d < 3; d++) f[d] = (S->pk[i] + S->pk[j]) * g[d];
+        const double c = (S->pk[i] + S->pk[j]) * dw; /* (K-6)'s order of operations */
+        for (int d = 0; d < 3; d++) f[d] = c * e[d];
         return;
     }
+    double g[3];
+    for (int d = 0; d < 3; d++) g[d] = e[d] * dw;
     double bi[3], bj[3];
     bmul(S->Bg, i, g, bi);
     bmul(S->Bg, j, g, bj);
