@@ -308,10 +308,11 @@ static const char *tank = "dimension: 2\n"
 /* rho0 (u - u*)/dt = sum_j (P_a + P_j) g_aj - 2 mu (d+2) sum_j (u_aj.e_aj) e_aj w_v'/r
  * with P = P^kap + lambda s (K-6, K-7a) at x^{k+1}, u^{k+1}, every pair formed here.  The
  * left side is of the size of the forces; the residual must be that of the direct solve.
- * gradient: corrected (doc/methods.md §8, the internal friction): kappa's part of a pair of
- * fluid particles is (P^kap_a Bg_a + P^kap_j Bg_j) g_aj, Bg_a = -(I + M^W_a) (M^F_a)^-1 with
- * M_a = sum_j g_aj r_aj^T over a's fluid (F) and wall and dummy (W) neighbours, formed and
- * inverted here (2 x 2); the wall pairs keep (K-6)'s (P^kap_a + P^kap_j) g_aj. */
+ * gradient: corrected (doc/methods.md §8, the internal friction): the pair force of two
+ * fluid particles is (P_a Bg_a + P_j Bg_j) g_aj, Bg_a = -(I + M^W_a) (M^F_a)^-1 with M_a =
+ * sum_j g_aj r_aj^T over a's fluid (F) and wall and dummy (W) neighbours, formed and inverted
+ * here (2 x 2), and lambda's s_i = sum_j u_ij.Bg_i g_ij over i's fluid pairs (u_ij.g_ij on
+ * wall pairs); the wall pairs keep (K-6)'s (P_a + P_j) g_aj. */
 static void step_equations(int gradient)
 {
     lub_particles P = {0};
@@ -340,20 +341,6 @@ static void step_equations(int gradient)
     }
     CHECK(run(&m, dt, 1) == 0);
     CHECK(lub_csr_asymmetry(&m.A) < 1e-12);
-    /* n, P^kap, s of every particle at x^{k+1}, u^{k+1} */
-    double *nn = lub_calloc(n, sizeof *nn), *s = lub_calloc(n, sizeof *s);
-    const double n0 = lub_mph_n0(2, l0);
-    for (size_t i = 0; i < n; i++)
-        for (size_t j = 0; j < n; j++) {
-            if (i == j) continue;
-            const double dx = P.x[0][j] - P.x[0][i], dy = P.x[1][j] - P.x[1][i];
-            const double r = sqrt(dx * dx + dy * dy) / l0;
-            if (r >= 1.75) continue;
-            nn[i] += kw(2, 1.75, r);
-            const double ue =
-                ((P.u[0][j] - P.u[0][i]) * dx + (P.u[1][j] - P.u[1][i]) * dy) / (r * l0);
-            s[i] += ue * kdw(2, 1.75, r) / l0;
-        }
     /* Bg of every fluid particle (the identity where unused) */
     double(*Bg)[4] = lub_calloc(n, sizeof *Bg);
     for (size_t i = 0; i < n; i++) {
@@ -377,6 +364,24 @@ static void step_equations(int gradient)
                 Bg[i][2 * a + b] = -((a == 0 ? 1 + MW[0] : MW[2]) * inv[b] +
                                      (a == 0 ? MW[1] : 1 + MW[3]) * inv[2 + b]);
     }
+    /* n, P^kap, s of every particle at x^{k+1}, u^{k+1} */
+    double *nn = lub_calloc(n, sizeof *nn), *s = lub_calloc(n, sizeof *s);
+    const double n0 = lub_mph_n0(2, l0);
+    for (size_t i = 0; i < n; i++)
+        for (size_t j = 0; j < n; j++) {
+            if (i == j) continue;
+            const double dx = P.x[0][j] - P.x[0][i], dy = P.x[1][j] - P.x[1][i];
+            const double r = sqrt(dx * dx + dy * dy) / l0;
+            if (r >= 1.75) continue;
+            nn[i] += kw(2, 1.75, r);
+            /* s_i = sum_j u_ij.B_ij g_ij, B_ij = Bg_i between fluid particles */
+            const int both = P.kind[i] == LUB_FLUID && P.kind[j] == LUB_FLUID;
+            const double e[2] = {dx / (r * l0), dy / (r * l0)}, dw = kdw(2, 1.75, r) / l0;
+            for (int d = 0; d < 2; d++) {
+                const double bg = both ? Bg[i][2 * d] * e[0] + Bg[i][2 * d + 1] * e[1] : e[d];
+                s[i] += (P.u[d][j] - P.u[d][i]) * bg * dw;
+            }
+        }
     double worst = 0, scale = 0, pmax = 0, perr = 0;
     int ncompressed = 0;
     for (size_t a = 0; a < n; a++) {
@@ -397,7 +402,7 @@ static void step_equations(int gradient)
                 for (int d = 0; d < 2; d++) {
                     const double ga = both ? Bg[a][2 * d] * e[0] + Bg[a][2 * d + 1] * e[1] : e[d];
                     const double gj = both ? Bg[j][2 * d] * e[0] + Bg[j][2 * d + 1] * e[1] : e[d];
-                    F[d] += (ka * ga + kj * gj + (la + lj) * e[d]) * dw;
+                    F[d] += ((ka + la) * ga + (kj + lj) * gj) * dw;
                 }
             }
             if (r < 3.5) {
@@ -581,6 +586,50 @@ static void test_corrected_divergence(void)
         }
         lub_particles_free(&P);
     }
+}
+
+/* gradient: corrected takes lambda's divergence as s_i = sum_j u_ij.B_ij g_ij with B_ij =
+ * Bg_i between fluid particles and I on the wall pairs (mph.c, correction_gradient), which
+ * is -tr G exactly for u = G x (walls and dummies carrying it too) because Bg_i M^F_i +
+ * M^W_i = -I: the jittered tank, every fluid particle whose fluid neighbours are not too
+ * deficient (all below the top 2 rows), against -tr G; the plain sum's error printed. */
+static void test_corrected_gradient_divergence(void)
+{
+    lub_particles P = {0};
+    lub_geometry g;
+    generate(tank, &P, &g);
+    const double G[2][2] = {{0.3, 0.5}, {0.1, 0.4}}, trG = 0.7;
+    double err[2] = {0, 0};
+    int nchecked = 0;
+    for (int corr = 0; corr <= 1; corr++) {
+        lub_mps_config c;
+        config(&c, 1000, 1e-6, 1, 1);
+        c.gradient_corrected = corr;
+        lub_mps m;
+        lub_mps_init(&m, &P, &c, g.dmin, g.dmax, g.periodic);
+        double top = -INFINITY;
+        for (size_t i = 0; i < P.n; i++) {
+            for (int a = 0; a < 2; a++) P.u[a][i] = G[a][0] * P.x[0][i] + G[a][1] * P.x[1][i];
+            if (P.kind[i] == LUB_FLUID) top = fmax(top, P.x[1][i]);
+        }
+        double *div = lub_calloc(P.n, sizeof *div);
+        lub_mph_operators(&m, NULL, div, NULL);
+        for (size_t i = 0; i < P.n; i++)
+            if (P.kind[i] == LUB_FLUID && P.x[1][i] < top - 2e-3) {
+                err[corr] = fmax(err[corr], fabs(div[i] + trG));
+                nchecked += corr;
+            }
+        free(div);
+        lub_mps_free(&m);
+    }
+    printf("  jittered tank, %d fluid particles (walls included in their sums): |s_i + tr G| up "
+           "to %.3g (plain), %.3g (gradient corrected)\n",
+           nchecked, err[0], err[1]);
+    CHECK(nchecked > 30);
+    CHECK(err[1] < 1e-10);
+    CHECK(err[0] > 1e-3);
+    lub_particles_free(&P);
+    lub_geometry_free(&g);
 }
 
 /* A 2-D column of water 10 l0 wide and H = 20 l0 deep in a closed tank (box walls,
@@ -921,6 +970,7 @@ int main(void)
     RUN(test_step_equations);
     RUN(test_rotating_drop);
     RUN(test_corrected_divergence);
+    RUN(test_corrected_gradient_divergence);
     RUN(test_hydrostatic);
     RUN(test_closed_box_energy);
     RUN(test_poiseuille);

@@ -178,7 +178,15 @@ double lub_mph_layer_quadrature(int dim)
  * gradient of (K-3)'s potential (the elastic energy changes at sum_i P_i s_i dV, the force's
  * power is -sum_i P_i s^g_i dV with the corrected s^g): not conserved (it grows where little
  * dissipation damps the particles: methods.md §8).  Where M^F_i is too deficient to invert
- * (CORR_MIN), Bg_i = I. */
+ * (CORR_MIN), Bg_i = I.
+ *
+ * Lambda's pair force is the gradient of the dissipation (lambda/2) sum_i s_i^2 dV, so it is
+ * renormalised through the divergence: with gradient: corrected s_i = sum_j u_ij.B_ij g_ij,
+ * B_ij = Bg_i between fluid particles, I on wall pairs and for the wall particles' own sums
+ * (pair_b).  Then s_i = -div u exactly for linear fields (Bg_i M^F_i + M^W_i = -I), a rigid
+ * rotation has none, the force lambda (s_i B_ij + s_j B_ji) g_ij has kappa's structure, and
+ * the dissipation stays a positive semi-definite quadratic form: the system SPD, the energy
+ * decreasing through it.  This replaces divergence: corrected's B_i on every pair. */
 
 /* m0: -M = m0 I on the lattice interior, m0 = sum_j r_j (-w_p'(r_j)) / d (l0 = 1). */
 static double lattice_m(int dim)
@@ -294,8 +302,34 @@ typedef struct {
                           with the plain sum (B_i = I; see correction) */
     double *Bg;        /* gradient: corrected: Bg_i of the fluid particles (3 x 3, row-major,
                           not symmetric), NULL with the plain pair force */
+    double *Gd[3];     /* gradient: corrected: sum_j B_ij g_ij (B_ij = Bg_i between fluid
+                          particles, else I): -ds_i/du_i of the bulk viscosity's divergence */
     double m0;         /* the lattice interior's -M = m0 I (correction) */
 } mph_state;
+
+/* out = B_ij v, the renormalisation of pair (i, j) on particle i's side in the bulk
+ * viscosity's divergence s_i = sum_j u_ij.B_ij g_ij: Bg_i between fluid particles with
+ * gradient: corrected (I on a wall pair, and for a wall particle's own sum), B_i with
+ * divergence: corrected, else I */
+static inline void pair_b(const lub_mps *m, const mph_state *S, size_t i, size_t j,
+                          const double v[3], double out[3])
+{
+    if (S->Bg)
+        bmul(m->P->kind[i] == LUB_FLUID && m->P->kind[j] == LUB_FLUID ? S->Bg : NULL, i, v, out);
+    else
+        bmul(S->B, i, v, out);
+}
+
+/* out = sum_j B_ij g_ij = -ds_i/du_i */
+static inline void diag_b(const mph_state *S, size_t i, double out[3])
+{
+    if (S->Bg) {
+        for (int d = 0; d < 3; d++) out[d] = S->Gd[d][i];
+        return;
+    }
+    const double G[3] = {S->G[0][i], S->G[1][i], S->G[2][i]};
+    bmul(S->B, i, G, out);
+}
 
 static void state_free(void *p)
 {
@@ -311,6 +345,7 @@ static void state_free(void *p)
     free(S->blk);
     free(S->B);
     free(S->Bg);
+    for (int d = 0; d < 3; d++) free(S->Gd[d]);
     free(S);
 }
 
@@ -335,8 +370,14 @@ static mph_state *state(lub_mps *m)
     S->pload = lub_particles_extra(m->P, "pLoad");
     S->pkout = lub_particles_extra(m->P, "pKappa");
     if (m->c.divergence_corrected || m->c.gradient_corrected) S->m0 = lattice_m(m->dim);
-    if (m->c.divergence_corrected) S->B = lub_calloc(9 * n, sizeof(double));
-    if (m->c.gradient_corrected) S->Bg = lub_calloc(9 * n, sizeof(double));
+    /* gradient: corrected renormalises lambda's pair force and its divergence with Bg too
+     * (the wall pairs central), in place of divergence: corrected's B on every pair */
+    if (m->c.divergence_corrected && !m->c.gradient_corrected)
+        S->B = lub_calloc(9 * n, sizeof(double));
+    if (m->c.gradient_corrected) {
+        S->Bg = lub_calloc(9 * n, sizeof(double));
+        for (int d = 0; d < 3; d++) S->Gd[d] = lub_calloc(n, sizeof(double));
+    }
     m->fstate = S;
     m->fstate_free = state_free;
     if (m->c.list_l0 < LUB_MPH_HV)
@@ -382,7 +423,7 @@ static void density(lub_mps *m, mph_state *S)
 #pragma omp parallel for schedule(static) if (P->n >= LUB_LINALG_OMP_MIN)
     for (size_t i = 0; i < P->n; i++) {
         /* M_i = sum_j g_ij r_ij^T: MF over the fluid neighbours, MW over the rest */
-        double n = 0, G[3] = {0, 0, 0}, MF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0},
+        double n = 0, G[3] = {0, 0, 0}, GW[3] = {0, 0, 0}, MF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0},
                MW[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
         const int wantm = S->B || (S->Bg && P->kind[i] == LUB_FLUID);
         for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
@@ -393,7 +434,9 @@ static void density(lub_mps *m, mph_state *S)
             const double dw = lub_mph_dw(dim, l0, S->hp, r);
             for (int d = 0; d < dim; d++) G[d] += e[d] * dw;
             if (!wantm) continue;
-            double *M = P->kind[nb->j[q]] == LUB_FLUID ? MF : MW;
+            const int fl = P->kind[nb->j[q]] == LUB_FLUID;
+            double *M = fl ? MF : MW;
+            for (int d = 0; !fl && d < dim; d++) GW[d] += e[d] * dw;
             for (int a = 0; a < dim; a++)
                 for (int b = 0; b < dim; b++) M[3 * a + b] += e[a] * e[b] * dw * r;
         }
@@ -404,8 +447,15 @@ static void density(lub_mps *m, mph_state *S)
             for (int k = 0; k < 9; k++) M[k] = MF[k] + MW[k];
             correction(dim, M, S->m0, S->B + 9 * i);
         }
-        if (S->Bg && P->kind[i] == LUB_FLUID)
+        if (S->Bg && P->kind[i] == LUB_FLUID) {
             correction_gradient(dim, MF, MW, S->m0, S->Bg + 9 * i);
+            double GF[3], Gb[3];
+            for (int d = 0; d < 3; d++) GF[d] = G[d] - GW[d];
+            bmul(S->Bg, i, GF, Gb);
+            for (int d = 0; d < 3; d++) S->Gd[d][i] = Gb[d] + GW[d];
+        } else if (S->Bg) {
+            for (int d = 0; d < 3; d++) S->Gd[d][i] = G[d];
+        }
         S->pk[i] = kappa * fmax(n - S->n0, 0.0);
     }
 }
@@ -419,17 +469,25 @@ static void divergence(lub_mps *m, mph_state *S, double *s)
 #pragma omp parallel for schedule(static) if (P->n >= LUB_LINALG_OMP_MIN)
     for (size_t i = 0; i < P->n; i++) {
         double T[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}; /* sum_j u_ij g_ij^T */
+        double v = 0;                              /* sum_j u_ij.B_ij g_ij (pair_b), Bg */
         for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
             double e[3];
             const double r = pair_r(nb, q, dim, e);
             if (!(r < S->hp) || r == 0) continue;
             const size_t j = nb->j[q];
             const double dw = lub_mph_dw(dim, m->l0, S->hp, r);
+            if (S->Bg) {
+                double g[3], bg[3];
+                for (int d = 0; d < 3; d++) g[d] = e[d] * dw;
+                pair_b(m, S, i, j, g, bg);
+                for (int a = 0; a < dim; a++) v += (P->u[a][j] - P->u[a][i]) * bg[a];
+                continue;
+            }
             for (int a = 0; a < dim; a++)
                 for (int b = 0; b < dim; b++) T[3 * a + b] += (P->u[a][j] - P->u[a][i]) * e[b] * dw;
         }
-        double v = 0; /* sum_j u_ij.B_i g_ij = sum_ab T_ab B_ab (B symmetric) */
-        for (int a = 0; a < dim; a++) {
+        /* plain, divergence: corrected: sum_j u_ij.B_i g_ij = sum_ab T_ab B_ab (B symmetric) */
+        for (int a = 0; !S->Bg && a < dim; a++) {
             if (!S->B) v += T[4 * a];
             for (int b = 0; S->B && b < dim; b++) v += T[3 * a + b] * S->B[9 * i + 3 * a + b];
         }
@@ -470,11 +528,17 @@ static void pair_pressure(const lub_mps *m, const mph_state *S, size_t i, size_t
         for (int d = 0; d < 3; d++) f[d] = (P->p[i] + P->p[j]) * g[d];
         return;
     }
-    double fk[3], bi[3], bj[3];
-    pair_elastic(m, S, i, j, e, dw, fk);
-    bmul(S->B, i, g, bi);
-    bmul(S->B, j, g, bj);
+    double bi[3], bj[3];
+    pair_b(m, S, i, j, g, bi);
+    pair_b(m, S, j, i, g, bj);
     const double lam = m->c.bulk_viscosity;
+    if (!S->Bg) { /* divergence: corrected alone, in its own order of operations */
+        for (int d = 0; d < 3; d++)
+            f[d] = (S->pk[i] + S->pk[j]) * g[d] + lam * (S->s[i] * bi[d] + S->s[j] * bj[d]);
+        return;
+    }
+    double fk[3];
+    pair_elastic(m, S, i, j, e, dw, fk);
     for (int d = 0; d < 3; d++) f[d] = fk[d] + lam * (S->s[i] * bi[d] + S->s[j] * bj[d]);
 }
 
@@ -556,25 +620,30 @@ static int assemble(lub_mps *m, mph_state *S, double dt)
                 size_t i;
                 double Dia[3] = {0, 0, 0};
                 double v[3] = {0, 0, 0};
-                if (qa == nb->end[a]) { /* i = a: D_aa = -B_a G_a */
+                if (qa == nb->end[a]) { /* i = a: D_aa = -sum_j B_aj g_aj */
                     i = a;
-                    for (int c = 0; c < dim; c++) v[c] = -S->G[c][a];
+                    diag_b(S, a, v);
+                    for (int c = 0; c < dim; c++) v[c] = -v[c];
                 } else {
                     double e[3];
                     const double rr = pair_r(nb, qa, dim, e);
                     if (!(rr < S->hp) || rr == 0) continue;
                     i = nb->j[qa];
-                    /* D_ia = B_i g_ia, g_ia = e_ia w'(r), e_ia = -e_ai */
+                    /* D_ia = B_ia g_ia, g_ia = e_ia w'(r), e_ia = -e_ai */
                     const double dw = lub_mph_dw(dim, l0, S->hp, rr);
                     for (int c = 0; c < dim; c++) v[c] = -e[c] * dw;
                 }
-                bmul(S->B, i, v, Dia);
+                if (i == a)
+                    for (int c = 0; c < 3; c++) Dia[c] = v[c];
+                else
+                    pair_b(m, S, i, a, v, Dia);
                 for (size_t qi = nb->start[i]; qi <= nb->end[i]; qi++) {
                     size_t b;
                     double Dib[3], v2[3] = {0, 0, 0};
                     if (qi == nb->end[i]) {
                         b = i;
-                        for (int c = 0; c < dim; c++) v2[c] = -S->G[c][i];
+                        diag_b(S, i, v2);
+                        for (int c = 0; c < dim; c++) v2[c] = -v2[c];
                     } else {
                         double e[3];
                         const double rr = pair_r(nb, qi, dim, e);
@@ -583,7 +652,10 @@ static int assemble(lub_mps *m, mph_state *S, double dt)
                         const double dw = lub_mph_dw(dim, l0, S->hp, rr);
                         for (int c = 0; c < dim; c++) v2[c] = e[c] * dw;
                     }
-                    bmul(S->B, i, v2, Dib);
+                    if (b == i)
+                        for (int c = 0; c < 3; c++) Dib[c] = v2[c];
+                    else
+                        pair_b(m, S, i, b, v2, Dib);
                     if (P->kind[b] == LUB_FLUID) {
                         if (S->pos[b] < 0) { /* beyond the lists: cannot be (2 h_p = h_v) */
                             S->nfar++;
@@ -931,16 +1003,21 @@ static void mph_header_level(const lub_mps *m)
                 m->l0, LUB_MPH_HP * m->l0, LUB_MPH_HV * m->l0, lub_mph_n0(m->dim, m->l0), m->c.rho,
                 m->c.rho * m->c.nu, m->c.bulk_viscosity, m->c.bulk_modulus);
     lub_message("MPH: divergence %s",
-                m->c.divergence_corrected
+                m->c.gradient_corrected
+                    ? "corrected with the gradient's Bg (the bulk viscosity's s_i = sum_j "
+                      "u_ij.Bg_i g_ij between fluid particles, u_ij.g_ij on wall pairs: exact "
+                      "for linear fields)"
+                : m->c.divergence_corrected
                     ? "corrected (the bulk viscosity's s_i = sum_j u_ij.B_i g_ij, B_i = "
                       "-(sum_j g_ij r_ij^T)^-1: exact for linear fields, no bulk dissipation "
                       "in a shear)"
                     : "plain (Kondo's s_i = sum_j u_ij.g_ij of (K-7a))");
     lub_message("MPH: gradient %s",
                 m->c.gradient_corrected
-                    ? "corrected (kappa's pair force (P_i Bg_i + P_j Bg_j) g_ij between fluid "
+                    ? "corrected (the pair force (P_i Bg_i + P_j Bg_j) g_ij between fluid "
                       "particles, Bg_i = -(I + M^W_i)(M^F_i)^-1, central at walls: a packing's "
-                      "fabric carries no shear stress; energy not exactly conserved)"
+                      "fabric carries no shear stress; kappa's part conserves no energy "
+                      "exactly)"
                     : "plain ((K-6)'s central (P_i + P_j) g_ij)");
     if (m->c.viscous_layers)
         lub_message("MPH: viscousNormalisation layers: the viscous coefficient 2 (d+2) over "
