@@ -126,6 +126,9 @@ typedef struct {
     int divergence_corrected; /* MPH: the bulk viscosity's divergence renormalised, exact
                                  for linear velocity fields (divergence: corrected; 0:
                                  Kondo's kernel sum, plain) */
+    int gradient_corrected;   /* MPH: kappa's pair force with the renormalised kernel gradient
+                                 (P_i B_i + P_j B_j) g_ij (gradient: corrected; 0: (K-6)'s
+                                 (P_i + P_j) g_ij, plain) */
     double patch_velocity[LUB_MAX_PATCHES][3]; /* wall velocities (movingWalls); on a patch
                                                   a model moves: a velocity of its largest
                                                   speed (lubFoam's Courant number), or 0 */

@@ -152,6 +152,42 @@ double lub_mph_layer_quadrature(int dim)
  * which keeps all three properties too (g_ij parallel to r_ij). */
 #define CORR_MIN 0.2
 
+/* gradient: corrected (issue 29; doc/methods.md §8, the internal friction).  Kappa's pair
+ * force (P_i + P_j) g_ij of (K-6) is central, and its virial on particle i, sum_j (P_i +
+ * P_j) g_ij r_ij^T, is P M_i for a uniform P: on a packing that a shear keeps disordered and
+ * anisotropic (M_i,xy != 0, the fabric) it carries a shear stress P M_xy, an internal
+ * friction of about 0.015 (the jittered channel: M_xy/m0 = 0.01-0.015, and kappa's pair
+ * virial 57% of the shear stress in the half of the channel at 138 Pa).  The corrected
+ * force renormalises the kernel gradient per particle, as B_i does for the divergence:
+ *
+ *     f_ij = (P_i Bg_i + P_j Bg_j) g_ij            fluid i, j
+ *     f_ij = (P_i + P_j) g_ij                      i or j a wall or dummy particle
+ *     Bg_i = -(I + M^W_i) (M^F_i)^-1               M^F, M^W: M_i over i's fluid, and its
+ *                                                  wall and dummy neighbours
+ *
+ * so that Bg_i M^F_i + M^W_i = -I: each fluid particle's own pressure has the isotropic
+ * virial -P_i I over all its pairs (in the bulk M^W = 0, Bg = B of the divergence).  The
+ * wall pairs stay central: with Bg = -M_i^-1 on them too (the fluid's fabric rotating its
+ * wall pairs) flat walls push a sheared film along (the jittered channel at a mean 95 Pa:
+ * +0.011 N/m over both walls, a tenth of their shear load; the flux rose 9% from 13 to 182
+ * Pa); with that B on the fluid pairs and the wall pairs central, the near-wall rows keep
+ * part of the friction (-6.6%).
+ * Momentum: f_ji = -f_ij.  Angular momentum: the torque of i's pairs is the antisymmetric
+ * part of Bg_i M^F_i + M^W_i = -I, none; a wall's pairs are central (fluid and rigid bodies
+ * together keep it exactly, as with the plain force).  Energy: the force is no longer the
+ * gradient of (K-3)'s potential (the elastic energy changes at sum_i P_i s_i dV, the force's
+ * power is -sum_i P_i s^g_i dV with the corrected s^g): not conserved (it grows where little
+ * dissipation damps the particles: methods.md §8).  Where M^F_i is too deficient to invert
+ * (CORR_MIN), Bg_i = I.
+ *
+ * Lambda's pair force is the gradient of the dissipation (lambda/2) sum_i s_i^2 dV, so it is
+ * renormalised through the divergence: with gradient: corrected s_i = sum_j u_ij.B_ij g_ij,
+ * B_ij = Bg_i between fluid particles, I on wall pairs and for the wall particles' own sums
+ * (pair_b).  Then s_i = -div u exactly for linear fields (Bg_i M^F_i + M^W_i = -I), a rigid
+ * rotation has none, the force lambda (s_i B_ij + s_j B_ji) g_ij has kappa's structure, and
+ * the dissipation stays a positive semi-definite quadratic form: the system SPD, the energy
+ * decreasing through it.  This replaces divergence: corrected's B_i on every pair. */
+
 /* m0: -M = m0 I on the lattice interior, m0 = sum_j r_j (-w_p'(r_j)) / d (l0 = 1). */
 static double lattice_m(int dim)
 {
@@ -169,7 +205,7 @@ static double lattice_m(int dim)
 
 /* B = -M^-1 for the symmetric M (row-major 3 x 3, dim x dim used), or I where the smallest
  * eigenvalue of -M is below CORR_MIN m0. */
-static void correction(int dim, const double M[9], double m0, double B[9])
+static int correction(int dim, const double M[9], double m0, double B[9])
 {
     double A[9]; /* -M */
     for (int k = 0; k < 9; k++) A[k] = -M[k], B[k] = 0.0;
@@ -197,14 +233,14 @@ static void correction(int dim, const double M[9], double m0, double B[9])
     }
     if (!(lmin > CORR_MIN * m0)) {
         B[0] = B[4] = B[8] = 1.0;
-        return;
+        return 0;
     }
     if (dim == 2) {
         const double det = A[0] * A[4] - A[1] * A[3];
         B[0] = A[4] / det, B[4] = A[0] / det;
         B[1] = -A[1] / det, B[3] = -A[3] / det;
         B[8] = 1.0;
-        return;
+        return 1;
     }
     const double c0 = A[4] * A[8] - A[5] * A[7], c1 = A[5] * A[6] - A[3] * A[8],
                  c2 = A[3] * A[7] - A[4] * A[6];
@@ -215,6 +251,21 @@ static void correction(int dim, const double M[9], double m0, double B[9])
     B[5] = (A[2] * A[3] - A[0] * A[5]) / det;
     B[6] = c2 / det, B[7] = (A[1] * A[6] - A[0] * A[7]) / det,
     B[8] = (A[0] * A[4] - A[1] * A[3]) / det;
+    return 1;
+}
+
+/* Bg = -(I + MW) MF^-1 (gradient: corrected, above), or I where MF is deficient */
+static void correction_gradient(int dim, const double MF[9], const double MW[9], double m0,
+                                double Bg[9])
+{
+    double Bf[9];
+    const int ok = correction(dim, MF, m0, Bf);
+    for (int a = 0; a < 3; a++)
+        for (int b = 0; b < 3; b++) {
+            double v = 0;
+            for (int c = 0; c < 3; c++) v += ((a == c ? 1.0 : 0.0) + MW[3 * a + c]) * Bf[3 * c + b];
+            Bg[3 * a + b] = ok ? v : (a == b ? 1.0 : 0.0);
+        }
 }
 
 /* out = B_i v (v itself with the plain sum) */
@@ -249,8 +300,36 @@ typedef struct {
     double *pkout;     /* the particle field pKappa: P^kap_i, kappa's part of P */
     double *B;         /* divergence: corrected: B_i (3 x 3 per particle, row-major), NULL
                           with the plain sum (B_i = I; see correction) */
+    double *Bg;        /* gradient: corrected: Bg_i of the fluid particles (3 x 3, row-major,
+                          not symmetric), NULL with the plain pair force */
+    double *Gd[3];     /* gradient: corrected: sum_j B_ij g_ij (B_ij = Bg_i between fluid
+                          particles, else I): -ds_i/du_i of the bulk viscosity's divergence */
     double m0;         /* the lattice interior's -M = m0 I (correction) */
 } mph_state;
+
+/* out = B_ij v, the renormalisation of pair (i, j) on particle i's side in the bulk
+ * viscosity's divergence s_i = sum_j u_ij.B_ij g_ij: Bg_i between fluid particles with
+ * gradient: corrected (I on a wall pair, and for a wall particle's own sum), B_i with
+ * divergence: corrected, else I */
+static inline void pair_b(const lub_mps *m, const mph_state *S, size_t i, size_t j,
+                          const double v[3], double out[3])
+{
+    if (S->Bg)
+        bmul(m->P->kind[i] == LUB_FLUID && m->P->kind[j] == LUB_FLUID ? S->Bg : NULL, i, v, out);
+    else
+        bmul(S->B, i, v, out);
+}
+
+/* out = sum_j B_ij g_ij = -ds_i/du_i */
+static inline void diag_b(const mph_state *S, size_t i, double out[3])
+{
+    if (S->Bg) {
+        for (int d = 0; d < 3; d++) out[d] = S->Gd[d][i];
+        return;
+    }
+    const double G[3] = {S->G[0][i], S->G[1][i], S->G[2][i]};
+    bmul(S->B, i, G, out);
+}
 
 static void state_free(void *p)
 {
@@ -265,6 +344,8 @@ static void state_free(void *p)
     free(S->blkp);
     free(S->blk);
     free(S->B);
+    free(S->Bg);
+    for (int d = 0; d < 3; d++) free(S->Gd[d]);
     free(S);
 }
 
@@ -288,9 +369,14 @@ static mph_state *state(lub_mps *m)
     for (size_t i = 0; i < n; i++) S->pos[i] = -1;
     S->pload = lub_particles_extra(m->P, "pLoad");
     S->pkout = lub_particles_extra(m->P, "pKappa");
-    if (m->c.divergence_corrected) {
+    if (m->c.divergence_corrected || m->c.gradient_corrected) S->m0 = lattice_m(m->dim);
+    /* gradient: corrected renormalises lambda's pair force and its divergence with Bg too
+     * (the wall pairs central), in place of divergence: corrected's B on every pair */
+    if (m->c.divergence_corrected && !m->c.gradient_corrected)
         S->B = lub_calloc(9 * n, sizeof(double));
-        S->m0 = lattice_m(m->dim);
+    if (m->c.gradient_corrected) {
+        S->Bg = lub_calloc(9 * n, sizeof(double));
+        for (int d = 0; d < 3; d++) S->Gd[d] = lub_calloc(n, sizeof(double));
     }
     m->fstate = S;
     m->fstate_free = state_free;
@@ -336,7 +422,10 @@ static void density(lub_mps *m, mph_state *S)
     const double kappa = m->c.bulk_modulus, l0 = m->l0;
 #pragma omp parallel for schedule(static) if (P->n >= LUB_LINALG_OMP_MIN)
     for (size_t i = 0; i < P->n; i++) {
-        double n = 0, G[3] = {0, 0, 0}, M[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+        /* M_i = sum_j g_ij r_ij^T: MF over the fluid neighbours, MW over the rest */
+        double n = 0, G[3] = {0, 0, 0}, GW[3] = {0, 0, 0}, MF[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0},
+               MW[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0};
+        const int wantm = S->B || (S->Bg && P->kind[i] == LUB_FLUID);
         for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
             double e[3];
             const double r = pair_r(nb, q, dim, e);
@@ -344,13 +433,29 @@ static void density(lub_mps *m, mph_state *S)
             n += lub_mph_w(dim, l0, S->hp, r);
             const double dw = lub_mph_dw(dim, l0, S->hp, r);
             for (int d = 0; d < dim; d++) G[d] += e[d] * dw;
-            if (S->B) /* M_i = sum_j g_ij r_ij^T */
-                for (int a = 0; a < dim; a++)
-                    for (int b = 0; b < dim; b++) M[3 * a + b] += e[a] * e[b] * dw * r;
+            if (!wantm) continue;
+            const int fl = P->kind[nb->j[q]] == LUB_FLUID;
+            double *M = fl ? MF : MW;
+            for (int d = 0; !fl && d < dim; d++) GW[d] += e[d] * dw;
+            for (int a = 0; a < dim; a++)
+                for (int b = 0; b < dim; b++) M[3 * a + b] += e[a] * e[b] * dw * r;
         }
         m->pnd[i] = n;
         for (int d = 0; d < 3; d++) S->G[d][i] = G[d];
-        if (S->B) correction(dim, M, S->m0, S->B + 9 * i);
+        if (S->B) {
+            double M[9];
+            for (int k = 0; k < 9; k++) M[k] = MF[k] + MW[k];
+            correction(dim, M, S->m0, S->B + 9 * i);
+        }
+        if (S->Bg && P->kind[i] == LUB_FLUID) {
+            correction_gradient(dim, MF, MW, S->m0, S->Bg + 9 * i);
+            double GF[3], Gb[3];
+            for (int d = 0; d < 3; d++) GF[d] = G[d] - GW[d];
+            bmul(S->Bg, i, GF, Gb);
+            for (int d = 0; d < 3; d++) S->Gd[d][i] = Gb[d] + GW[d];
+        } else if (S->Bg) {
+            for (int d = 0; d < 3; d++) S->Gd[d][i] = G[d];
+        }
         S->pk[i] = kappa * fmax(n - S->n0, 0.0);
     }
 }
@@ -364,17 +469,25 @@ static void divergence(lub_mps *m, mph_state *S, double *s)
 #pragma omp parallel for schedule(static) if (P->n >= LUB_LINALG_OMP_MIN)
     for (size_t i = 0; i < P->n; i++) {
         double T[9] = {0, 0, 0, 0, 0, 0, 0, 0, 0}; /* sum_j u_ij g_ij^T */
+        double v = 0;                              /* sum_j u_ij.B_ij g_ij (pair_b), Bg */
         for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
             double e[3];
             const double r = pair_r(nb, q, dim, e);
             if (!(r < S->hp) || r == 0) continue;
             const size_t j = nb->j[q];
             const double dw = lub_mph_dw(dim, m->l0, S->hp, r);
+            if (S->Bg) {
+                double g[3], bg[3];
+                for (int d = 0; d < 3; d++) g[d] = e[d] * dw;
+                pair_b(m, S, i, j, g, bg);
+                for (int a = 0; a < dim; a++) v += (P->u[a][j] - P->u[a][i]) * bg[a];
+                continue;
+            }
             for (int a = 0; a < dim; a++)
                 for (int b = 0; b < dim; b++) T[3 * a + b] += (P->u[a][j] - P->u[a][i]) * e[b] * dw;
         }
-        double v = 0; /* sum_j u_ij.B_i g_ij = sum_ab T_ab B_ab (B symmetric) */
-        for (int a = 0; a < dim; a++) {
+        /* plain, divergence: corrected: sum_j u_ij.B_i g_ij = sum_ab T_ab B_ab (B symmetric) */
+        for (int a = 0; !S->Bg && a < dim; a++) {
             if (!S->B) v += T[4 * a];
             for (int b = 0; S->B && b < dim; b++) v += T[3 * a + b] * S->B[9 * i + 3 * a + b];
         }
@@ -382,25 +495,51 @@ static void divergence(lub_mps *m, mph_state *S, double *s)
     }
 }
 
+/* Kappa's pair force per dV on particle i from its neighbour j (e = e_ij, dw = w_p'(r_ij)):
+ * (P^kap_i + P^kap_j) g_ij, or with gradient: corrected (P^kap_i Bg_i + P^kap_j Bg_j) g_ij
+ * between fluid particles (the wall pairs central; see correction_gradient). */
+static inline void pair_elastic(const lub_mps *m, const mph_state *S, size_t i, size_t j,
+                                const double e[3], double dw, double f[3])
+{
+    if (!S->Bg || m->P->kind[i] != LUB_FLUID || m->P->kind[j] != LUB_FLUID) {
+        const double c = (S->pk[i] + S->pk[j]) * dw; /* (K-6)'s order of operations */
+        for (int d = 0; d < 3; d++) f[d] = c * e[d];
+        return;
+    }
+    double g[3];
+    for (int d = 0; d < 3; d++) g[d] = e[d] * dw;
+    double bi[3], bj[3];
+    bmul(S->Bg, i, g, bi);
+    bmul(S->Bg, j, g, bj);
+    for (int d = 0; d < 3; d++) f[d] = S->pk[i] * bi[d] + S->pk[j] * bj[d];
+}
+
 /* The pressure pair force per dV on particle i from its neighbour j (e = e_ij, dw =
- * w_p'(r_ij)), as the step gave it: (P_i + P_j) g_ij with the plain sum, (P^kap_i + P^kap_j)
- * g_ij + lambda (s_i B_i + s_j B_j) g_ij with the corrected one (s, P at u^{k+1}). */
+ * w_p'(r_ij)), as the step gave it: (P_i + P_j) g_ij with the plain sum and the plain
+ * gradient; kappa's part as pair_elastic, lambda's lambda (s_i B_i + s_j B_j) g_ij with
+ * divergence: corrected (s, P at u^{k+1}). */
 static void pair_pressure(const lub_mps *m, const mph_state *S, size_t i, size_t j,
                           const double e[3], double dw, double f[3])
 {
     const lub_particles *P = m->P;
     double g[3];
     for (int d = 0; d < 3; d++) g[d] = e[d] * dw;
-    if (!S->B) {
+    if (!S->B && !S->Bg) {
         for (int d = 0; d < 3; d++) f[d] = (P->p[i] + P->p[j]) * g[d];
         return;
     }
     double bi[3], bj[3];
-    bmul(S->B, i, g, bi);
-    bmul(S->B, j, g, bj);
+    pair_b(m, S, i, j, g, bi);
+    pair_b(m, S, j, i, g, bj);
     const double lam = m->c.bulk_viscosity;
-    for (int d = 0; d < 3; d++)
-        f[d] = (S->pk[i] + S->pk[j]) * g[d] + lam * (S->s[i] * bi[d] + S->s[j] * bj[d]);
+    if (!S->Bg) { /* divergence: corrected alone, in its own order of operations */
+        for (int d = 0; d < 3; d++)
+            f[d] = (S->pk[i] + S->pk[j]) * g[d] + lam * (S->s[i] * bi[d] + S->s[j] * bj[d]);
+        return;
+    }
+    double fk[3];
+    pair_elastic(m, S, i, j, e, dw, fk);
+    for (int d = 0; d < 3; d++) f[d] = fk[d] + lam * (S->s[i] * bi[d] + S->s[j] * bj[d]);
 }
 
 /* Step 5: assemble the SPD system of the fluid velocities (see the top of the file) into
@@ -470,8 +609,9 @@ static int assemble(lub_mps *m, mph_state *S, double dt)
                         rhs[c] += v * P->u[c2][j];
                 }
             if (rr < S->hp) {
-                const double f = (S->pk[a] + S->pk[j]) * lub_mph_dw(dim, l0, S->hp, rr);
-                for (int c = 0; c < dim; c++) rhs[c] += f * e[c];
+                double f[3];
+                pair_elastic(m, S, a, j, e, lub_mph_dw(dim, l0, S->hp, rr), f);
+                for (int c = 0; c < dim; c++) rhs[c] += f[c];
             }
         }
         /* bulk viscosity: lambda sum_i D_ia D_ib^T over i = a and the particles within h_p */
@@ -480,25 +620,30 @@ static int assemble(lub_mps *m, mph_state *S, double dt)
                 size_t i;
                 double Dia[3] = {0, 0, 0};
                 double v[3] = {0, 0, 0};
-                if (qa == nb->end[a]) { /* i = a: D_aa = -B_a G_a */
+                if (qa == nb->end[a]) { /* i = a: D_aa = -sum_j B_aj g_aj */
                     i = a;
-                    for (int c = 0; c < dim; c++) v[c] = -S->G[c][a];
+                    diag_b(S, a, v);
+                    for (int c = 0; c < dim; c++) v[c] = -v[c];
                 } else {
                     double e[3];
                     const double rr = pair_r(nb, qa, dim, e);
                     if (!(rr < S->hp) || rr == 0) continue;
                     i = nb->j[qa];
-                    /* D_ia = B_i g_ia, g_ia = e_ia w'(r), e_ia = -e_ai */
+                    /* D_ia = B_ia g_ia, g_ia = e_ia w'(r), e_ia = -e_ai */
                     const double dw = lub_mph_dw(dim, l0, S->hp, rr);
                     for (int c = 0; c < dim; c++) v[c] = -e[c] * dw;
                 }
-                bmul(S->B, i, v, Dia);
+                if (i == a)
+                    for (int c = 0; c < 3; c++) Dia[c] = v[c];
+                else
+                    pair_b(m, S, i, a, v, Dia);
                 for (size_t qi = nb->start[i]; qi <= nb->end[i]; qi++) {
                     size_t b;
                     double Dib[3], v2[3] = {0, 0, 0};
                     if (qi == nb->end[i]) {
                         b = i;
-                        for (int c = 0; c < dim; c++) v2[c] = -S->G[c][i];
+                        diag_b(S, i, v2);
+                        for (int c = 0; c < dim; c++) v2[c] = -v2[c];
                     } else {
                         double e[3];
                         const double rr = pair_r(nb, qi, dim, e);
@@ -507,7 +652,10 @@ static int assemble(lub_mps *m, mph_state *S, double dt)
                         const double dw = lub_mph_dw(dim, l0, S->hp, rr);
                         for (int c = 0; c < dim; c++) v2[c] = e[c] * dw;
                     }
-                    bmul(S->B, i, v2, Dib);
+                    if (b == i)
+                        for (int c = 0; c < 3; c++) Dib[c] = v2[c];
+                    else
+                        pair_b(m, S, i, b, v2, Dib);
                     if (P->kind[b] == LUB_FLUID) {
                         if (S->pos[b] < 0) { /* beyond the lists: cannot be (2 h_p = h_v) */
                             S->nfar++;
@@ -740,8 +888,9 @@ double lub_mph_energy(const lub_mps *m, const double g[3], double dt, double par
                 double ev[3];
                 const double r = pair_r(nb, q, dim, ev);
                 if (!(r < S->hp) || r == 0) continue;
-                const double f = (S->pk[i] + S->pk[nb->j[q]]) * lub_mph_dw(dim, m->l0, S->hp, r);
-                for (int d = 0; d < dim; d++) F[d] += f * ev[d] * dV;
+                double f[3];
+                pair_elastic(m, S, i, nb->j[q], ev, lub_mph_dw(dim, m->l0, S->hp, r), f);
+                for (int d = 0; d < dim; d++) F[d] += f[d] * dV;
             }
         for (int d = 0; d < dim; d++) {
             e[0] += 0.5 * mass * P->u[d][i] * P->u[d][i];
@@ -825,6 +974,9 @@ static void mph_read(lub_mps_config *c, const lub_case *cs, lub_node *models, lu
      * on any arrangement has none (correction, methods.md §8) */
     static const char *const divs[] = {"plain", "corrected", NULL};
     c->divergence_corrected = lub_dict_choice(entry, "divergence", divs, 0) == 1;
+    /* kappa's pair force: (K-6)'s central one, or with the kernel gradient renormalised so
+     * that a packing's fabric carries no shear stress (correction_gradient, methods.md §8) */
+    c->gradient_corrected = lub_dict_choice(entry, "gradient", divs, 0) == 1;
     lub_node *v = lub_dict_find(models, "viscosity");
     if (v)
         lub_node_error(v, "'viscosity' belongs to the fluid 'mps'; the fluid 'mph' takes its "
@@ -851,11 +1003,22 @@ static void mph_header_level(const lub_mps *m)
                 m->l0, LUB_MPH_HP * m->l0, LUB_MPH_HV * m->l0, lub_mph_n0(m->dim, m->l0), m->c.rho,
                 m->c.rho * m->c.nu, m->c.bulk_viscosity, m->c.bulk_modulus);
     lub_message("MPH: divergence %s",
-                m->c.divergence_corrected
+                m->c.gradient_corrected
+                    ? "corrected with the gradient's Bg (the bulk viscosity's s_i = sum_j "
+                      "u_ij.Bg_i g_ij between fluid particles, u_ij.g_ij on wall pairs: exact "
+                      "for linear fields)"
+                : m->c.divergence_corrected
                     ? "corrected (the bulk viscosity's s_i = sum_j u_ij.B_i g_ij, B_i = "
                       "-(sum_j g_ij r_ij^T)^-1: exact for linear fields, no bulk dissipation "
                       "in a shear)"
                     : "plain (Kondo's s_i = sum_j u_ij.g_ij of (K-7a))");
+    lub_message("MPH: gradient %s",
+                m->c.gradient_corrected
+                    ? "corrected (the pair force (P_i Bg_i + P_j Bg_j) g_ij between fluid "
+                      "particles, Bg_i = -(I + M^W_i)(M^F_i)^-1, central at walls: a packing's "
+                      "fabric carries no shear stress; kappa's part conserves no energy "
+                      "exactly)"
+                    : "plain ((K-6)'s central (P_i + P_j) g_ij)");
     if (m->c.viscous_layers)
         lub_message("MPH: viscousNormalisation layers: the viscous coefficient 2 (d+2) over "
                     "%.6f, its response to a shear across layers l0 apart",

@@ -19,6 +19,14 @@
  * sum_j u_ij.B_i g_ij, B_i = -(sum_j g_ij r_ij^T)^-1, exact for linear fields (mph.c,
  * correction): a shear on shifted rows then dissipates nothing through lambda.
  *
+ * gradient: corrected replaces kappa's pair force (P_i + P_j) g_ij between fluid particles by
+ * (P_i Bg_i + P_j Bg_j) g_ij, Bg_i = -(I + M^W_i)(M^F_i)^-1 (M over the fluid and over the
+ * wall and dummy neighbours; the wall pairs stay central): each particle's own pressure has
+ * the virial -P I, so a sheared packing's fabric carries no shear stress (the internal
+ * friction of methods.md §8); lambda's part through its divergence s_i = sum_j u_ij.B_ij g_ij
+ * with the same Bg (in place of divergence: corrected's B).  Momentum and angular momentum
+ * exact; kappa's part conserves no energy (mph.c, correction_gradient).
+ *
  * Walls (the seed is silent, as Kondo's code): wall and dummy particles alike count in n_i,
  * carry their prescribed velocity, get P from (K-7a) and exchange the same pair forces; the
  * wall must be at least h_v thick (a wall layer and 3 dummy layers: particleGenDict
