@@ -20,20 +20,20 @@
  *                                               (tests/cases/dropBench runs it)
  *
  * l0 = 0.1 mm, rho 1000; environment: LUB_STEPS (steps of LUB_DT, 2e-5 s), LUB_NU (1e-4),
- * LUB_KAPPA (3e3), LUB_LAMBDA (1), LUB_SIGMA (0.03), LUB_AMP (the mode-2 amplitude eps, 0.1),
- * LUB_RELAX (steps with nu 1e-4, lambda 1 before the mode is set moving, after the annealing
- * if any; an oscillating drop is annealed with these viscosities too), LUB_EVERY (steps
- * between printed lines, 100), LUB_PACK=rings (2-D: concentric rings l0 apart instead of the
- * lattice disc), LUB_ANNEAL=N (N steps of random velocity kicks first, their standard
- * deviation LUB_NOISE m/s, 0.01, falling to 0; LUB_SEED seeds them, 12345), LUB_DUMP=FILE (laplace:
- * x, y, P, the virial pressure of each particle at the end, in l0 and dp).  The laplace drop's
- * inside pressure is read three ways: the mean P of (K-7a), the force across the two cuts, and the
- * virial (the trace of the pair forces' stress) of the interior particles; at the end a radial
- * profile.  The pair sums run over the library's cell-linked neighbour lists (pairs_build);
- * the last line gives the cost: steps, wall time and its phases (the library's step and the
- * diagnostics).  The library's step is the cost: in 3-D a drop of 7,000 particles takes
- * 0.6-1.6 s per step on one thread, a reading of the diagnostics (every LUB_EVERY steps)
- * 0.1-0.35 s (about 2 s over all pairs).
+ * LUB_KAPPA (3e3), LUB_LAMBDA (1), LUB_GRADIENT (plain | corrected: the MPH fluid's gradient),
+ * LUB_SIGMA (0.03), LUB_AMP (the mode-2 amplitude eps, 0.1), LUB_RELAX (steps with nu 1e-4, lambda
+ * 1 before the mode is set moving, after the annealing if any; an oscillating drop is annealed with
+ * these viscosities too), LUB_EVERY (steps between printed lines, 100), LUB_PACK=rings (2-D:
+ * concentric rings l0 apart instead of the lattice disc), LUB_ANNEAL=N (N steps of random velocity
+ * kicks first, their standard deviation LUB_NOISE m/s, 0.01, falling to 0; LUB_SEED seeds them,
+ * 12345), LUB_DUMP=FILE (laplace: x, y, P, the virial pressure of each particle at the end, in l0
+ * and dp).  The laplace drop's inside pressure is read three ways: the mean P of (K-7a), the force
+ * across the two cuts, and the virial (the trace of the pair forces' stress) of the interior
+ * particles; at the end a radial profile.  The pair sums run over the library's cell-linked
+ * neighbour lists (pairs_build); the last line gives the cost: steps, wall time and its phases (the
+ * library's step and the diagnostics).  The library's step is the cost: in 3-D a drop of 7,000
+ * particles takes 0.6-1.6 s per step on one thread, a reading of the diagnostics (every LUB_EVERY
+ * steps) 0.1-0.35 s (about 2 s over all pairs).
  */
 #include <math.h>
 #include <stdio.h>
@@ -527,6 +527,11 @@ int main(int argc, char **argv)
     c.v_solver.kind = LUB_LINSOLVER_PCG;
     c.v_solver.pcg.precond = LUB_PRECOND_JACOBI;
     c.v_solver.pcg.tolerance = 1e-10;
+    /* LUB_GRADIENT=corrected: the MPH fluid's `gradient: corrected` (doc/methods.md §8) */
+    const char *grad = getenv("LUB_GRADIENT");
+    if (grad && strcmp(grad, "corrected") && strcmp(grad, "plain"))
+        lub_fatal("LUB_GRADIENT: expected plain or corrected, found '%s'", grad);
+    c.gradient_corrected = grad && !strcmp(grad, "corrected");
     char text[256];
     snprintf(text, sizeof text, "surfaceTension: { sigma: %.12g }\n", sigma);
     driver d;
