@@ -253,23 +253,27 @@ fail:
 }
 
 /* The KSP with its method, preconditioner and norm, made once per matrix object. */
-static int make_ksp(lub_petsc *s)
+/* *ksp of method type (lub_petsc_ksp) with the options' preconditioner; prefix: its options
+ * prefix ("" the main KSP's; "other_" lub_petsc_solve_other's, so that options meant for the
+ * symmetric solves, -ksp_type cg, stay theirs) */
+static int make_ksp(lub_petsc *s, KSP *ksp, lub_petsc_ksp type, const char *prefix)
 {
     static const char *const kt[] = {KSPCG, KSPGMRES, KSPBCGS};
     static const char *const pt[] = {PCHYPRE, PCGAMG, PCJACOBI, PCBJACOBI, PCSOR, PCNONE};
     PC pc;
-    TRY(KSPCreate(s->comm, &s->ksp));
-    TRY(KSPSetType(s->ksp, kt[s->o.ksp]));
-    TRY(KSPGetPC(s->ksp, &pc));
+    TRY(KSPCreate(s->comm, ksp));
+    TRY(KSPSetType(*ksp, kt[type]));
+    TRY(KSPGetPC(*ksp, &pc));
     TRY(PCSetType(pc, pt[s->o.pc]));
     if (s->o.pc == LUB_PETSC_PC_HYPRE) {
-        TRY(hypre_defaults(""));
+        TRY(hypre_defaults(prefix));
         TRY(PCHYPRESetType(pc, "boomeramg"));
     }
     /* ||b - A x|| / ||b|| as lubkit's PCG: GMRES only knows it with right preconditioning */
-    if (s->o.ksp == LUB_PETSC_KSP_GMRES) TRY(KSPSetPCSide(s->ksp, PC_RIGHT));
-    TRY(KSPSetNormType(s->ksp, KSP_NORM_UNPRECONDITIONED));
-    TRY(KSPSetFromOptions(s->ksp));
+    if (type == LUB_PETSC_KSP_GMRES) TRY(KSPSetPCSide(*ksp, PC_RIGHT));
+    TRY(KSPSetNormType(*ksp, KSP_NORM_UNPRECONDITIONED));
+    if (prefix[0]) TRY(KSPSetOptionsPrefix(*ksp, prefix));
+    TRY(KSPSetFromOptions(*ksp));
     return 0;
 fail:
     return -1;
@@ -329,7 +333,7 @@ lub_solve_status lub_petsc_setup(lub_petsc *s, const lub_csr *A, const lub_pcg_o
         if (dist) TRY(MatCreateVecs(s->A, NULL, &s->rv));
         s->n = A->n;
         s->nnz = A->nnz;
-        if (make_ksp(s)) goto fail;
+        if (make_ksp(s, &s->ksp, s->o.ksp, "")) goto fail;
     }
     TRY(KSPSetOperators(s->ksp, s->A, s->A));
     TRY(KSPSetUp(s->ksp));
@@ -481,20 +485,7 @@ static int other_setup(lub_petsc *s, const lub_csr *B)
                                       &s->B));
         s->bn = B->n;
         s->bnnz = B->nnz;
-        static const char *const pt[] = {PCHYPRE, PCGAMG, PCJACOBI, PCBJACOBI, PCSOR, PCNONE};
-        PC pc;
-        TRY(KSPCreate(s->comm, &s->kspb));
-        TRY(KSPSetType(s->kspb, KSPBCGS));
-        TRY(KSPGetPC(s->kspb, &pc));
-        TRY(PCSetType(pc, pt[s->o.pc]));
-        if (s->o.pc == LUB_PETSC_PC_HYPRE) {
-            TRY(hypre_defaults("other_"));
-            TRY(PCHYPRESetType(pc, "boomeramg"));
-        }
-        TRY(KSPSetNormType(s->kspb, KSP_NORM_UNPRECONDITIONED));
-        /* its own prefix: options meant for the symmetric solves (-ksp_type cg) stay theirs */
-        TRY(KSPSetOptionsPrefix(s->kspb, "other_"));
-        TRY(KSPSetFromOptions(s->kspb));
+        if (make_ksp(s, &s->kspb, LUB_PETSC_KSP_BCGS, "other_")) return -1;
     }
     TRY(KSPSetOperators(s->kspb, s->B, s->A));
     TRY(KSPSetUp(s->kspb));

@@ -86,6 +86,27 @@ static double apply_row(const lub_neighbours *nb, const double *coef, const doub
     return s;
 }
 
+/* The 2-D second-order fit's moment system of particle i: M = sum_j w_ij p p^T and rhs = sum_j
+ * w_ij p (f_j - f_i), p = (s_x, s_y, s_x^2, s_y^2, s_x s_y), s = r_ij / l0 (M, rhs zeroed
+ * here; 10 x 10 for the callers' solver); returns sum_j w_ij */
+static double moments2(const lub_neighbours *nb, size_t i, const double *f, double l0,
+                       double M[10][10], double rhs[10])
+{
+    double wsum = 0;
+    memset(M, 0, 10 * sizeof M[0]);
+    memset(rhs, 0, 10 * sizeof rhs[0]);
+    for (size_t k = nb->start[i]; k < nb->end[i]; k++) {
+        const double w = nb->w[k], sx = nb->dx[0][k] / l0, sy = nb->dx[1][k] / l0;
+        const double p[5] = {sx, sy, sx * sx, sy * sy, sx * sy}, df = f[nb->j[k]] - f[i];
+        wsum += w;
+        for (int a = 0; a < 5; a++) {
+            rhs[a] += w * p[a] * df;
+            for (int bb = 0; bb < 5; bb++) M[a][bb] += w * p[a] * p[bb];
+        }
+    }
+    return wsum;
+}
+
 static double smooth(double x, double y)
 {
     return sin(2 * x) * cos(3 * y) + x * x * y;
@@ -418,16 +439,9 @@ static void test_objective(void)
     for (size_t i = 0; i < c.n; i++) {
         if (!looked_at(&c, 1, i) || fs[i] || !(th[i] < 1)) continue;
         nblend++;
-        double M[10][10] = {{0}}, b[10] = {0}, s = 0;
-        for (size_t k = nb.start[i]; k < nb.end[i]; k++) {
-            const double w = nb.w[k], sx = nb.dx[0][k] / l0, sy = nb.dx[1][k] / l0;
-            const double p[5] = {sx, sy, sx * sx, sy * sy, sx * sy}, df = f[nb.j[k]] - f[i];
-            for (int a = 0; a < 5; a++) {
-                b[a] += w * p[a] * df;
-                for (int bb = 0; bb < 5; bb++) M[a][bb] += w * p[a] * p[bb];
-            }
-            s += cstd * w * df;
-        }
+        double M[10][10], b[10], s = 0;
+        moments2(&nb, i, f, l0, M, b);
+        for (size_t k = nb.start[i]; k < nb.end[i]; k++) s += cstd * nb.w[k] * (f[nb.j[k]] - f[i]);
         s *= 0.5 * l0 * l0; /* the target of e.a */
         /* g = e.M^-1 e */
         double M2[10][10], e[10] = {0, 0, 1, 1, 0}, cvec[10];
@@ -706,16 +720,8 @@ static void check_surface_rows(double weight)
         sb += e1 * e1, s0 += e2 * e2, sl += e3 * e3, sl0 += e4 * e4, sstd += (st - ex) * (st - ex);
         sr += ex * ex;
         /* the objective with the row minimised directly: (M + mu r r^T) a = sum_j w p df */
-        double M[10][10] = {{0}}, rhs[10] = {0}, wsum = 0;
-        for (size_t k = nb.start[i]; k < nb.end[i]; k++) {
-            const double w = nb.w[k], sx = nb.dx[0][k] / l0, sy = nb.dx[1][k] / l0;
-            const double p[5] = {sx, sy, sx * sx, sy * sy, sx * sy}, df = fs[nb.j[k]] - fs[i];
-            wsum += w;
-            for (int a = 0; a < 5; a++) {
-                rhs[a] += w * p[a] * df;
-                for (int bb = 0; bb < 5; bb++) M[a][bb] += w * p[a] * p[bb];
-            }
-        }
+        double M[10][10], rhs[10];
+        const double wsum = moments2(&nb, i, fs, l0, M, rhs);
         /* d/dy of (s_x, s_y, s_x^2, s_y^2, s_x s_y) at s_b = (0, d/l0) */
         const double db = d[i] / l0, r[5] = {0, 1, 0, 2 * db, 0};
         const double mu = wsum * w_ref(d[i], re) * weight;
@@ -796,16 +802,8 @@ static void test_surface_dirichlet(void)
     for (size_t i = 0; i < c.n; i++) {
         if (!looked_at(&c, 0, i) || !(d[i] > 0) || fl[i]) continue;
         nrows++;
-        double M[10][10] = {{0}}, rhs[10] = {0}, wsum = 0;
-        for (size_t k = nb.start[i]; k < nb.end[i]; k++) {
-            const double w = nb.w[k], sx = nb.dx[0][k] / l0, sy = nb.dx[1][k] / l0;
-            const double p[5] = {sx, sy, sx * sx, sy * sy, sx * sy}, df = f[nb.j[k]] - f[i];
-            wsum += w;
-            for (int a = 0; a < 5; a++) {
-                rhs[a] += w * p[a] * df;
-                for (int bb = 0; bb < 5; bb++) M[a][bb] += w * p[a] * p[bb];
-            }
-        }
+        double M[10][10], rhs[10];
+        const double wsum = moments2(&nb, i, f, l0, M, rhs);
         const double db = d[i] / l0, r[5] = {0, db, 0, db * db, 0};
         const double mu = wsum * w_ref(d[i], re) * LUB_LSMPS_BC_WEIGHT;
         for (int a = 0; a < 5; a++) {
