@@ -24,6 +24,16 @@ static void mps_read(lub_mps_config *c, const lub_case *cs, lub_node *models, lu
     lub_node *v = lub_dict_map_or(models, "viscosity");
     c->viscosity = v ? 1 + lub_dict_choice(v, "scheme", visc, 1) : LUB_VISCOSITY_NONE;
     lub_mps_config_read(c, cs->root);
+    /* the fitted viscous Laplacians are rows of the implicit system (T-31): the explicit
+     * step (T-7) sums T-3's pairs, and would ignore the key */
+    static const char *const lap[] = {"standard", "lsmps", "lsmpsStabilized"};
+    if (c->viscosity == LUB_VISCOSITY_EXPLICIT && LUB_LAPLACIAN_FITTED(c->lap_viscosity))
+        lub_node_error(lub_dict_find(v, "scheme"),
+                       "viscosity scheme 'explicit' takes the standard Laplacian (T-3, T-7), but "
+                       "system/schemes.yaml has laplacian.viscosity '%s', which only the "
+                       "implicit step has: set scheme: crankNicolson here, or "
+                       "laplacian.viscosity: standard there",
+                       lap[c->lap_viscosity]);
 }
 
 static void mps_header_level(const lub_mps *m)
