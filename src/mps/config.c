@@ -7,7 +7,7 @@
  *     minPressureShift: true         # p_hat of T-14 in the gradient
  *     negativePressure: clip         # clip | keep | cavitation
  *     dummyVelocity:    mirror       # mirror (ghost 2 U - u_i) | wall (U) | extrapolate | flux
- *     pressure:         { alpha: 0, gamma: 0.2, predictor: 0.1 }   # T-9; lub_mps_step
+ *     pressure:         { alpha: 0, gamma: 0.2, predictor: 0.1, trend: 0 }   # T-9; lub_mps_step
  *     freeSurface:      { beta: 0.97, asymmetry: 0.2, test: sector, sectorAngle: 60,
  *                         exposedAngle: 150 }
  *                       # T-12 + geometric tests (test: sector | centroid | pnd)
@@ -52,6 +52,7 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->gamma = 0.2;
     c->source = LUB_SOURCE_PND;
     c->predictor = 0.1;
+    c->trend = 0.0;
     c->beta = 0.97;
     c->surface_test = LUB_SURFACE_SECTOR;
     c->asymmetry = 0.2;
@@ -120,6 +121,7 @@ static void read_schemes(lub_mps_config *c, const char *path)
     c->alpha = lub_dict_real_or(p, "alpha", 0.0, LUB_NONNEGATIVE);
     c->gamma = lub_dict_real_or(p, "gamma", 0.2, (lub_range){0.0, 1.0, 1, 0});
     c->predictor = lub_dict_real_or(p, "predictor", c->predictor, LUB_BETWEEN(0.0, 1.0));
+    c->trend = lub_dict_real_or(p, "trend", c->trend, LUB_BETWEEN(0.0, 1.0));
     static const char *const sources[] = {"pnd", "mixed", NULL};
     c->source = lub_dict_choice(p, "source", sources, LUB_SOURCE_PND);
     lub_node *fs = lub_dict_map_or(r, "freeSurface");

@@ -87,6 +87,11 @@ void lub_mps_init(lub_mps *m, lub_particles *P, const lub_mps_config *c, const d
         m->gbar[d] = (c->predictor > 0 || LUB_DUMMY_CONTINUES(c->dummy_velocity)) && d < m->dim
                          ? lub_particles_extra(P, gbar_names[d])
                          : NULL;
+    static const char *const gtr_names[3] = {"gradPTrendx", "gradPTrendy", "gradPTrendz"};
+    for (int d = 0; d < 3; d++)
+        m->gtr[d] = m->gbar[d] && c->predictor > 0 && c->trend > 0
+                        ? lub_particles_extra(P, gtr_names[d])
+                        : NULL;
     m->cav =
         c->clip_negative == LUB_NEGATIVE_CAVITATION ? lub_particles_extra(P, "cavitation") : NULL;
     m->surf = NULL;
@@ -275,6 +280,9 @@ void lub_mps_resize(lub_mps *m, size_t cap)
     static const char *const gbar_names[3] = {"gradPx", "gradPy", "gradPz"};
     for (int d = 0; d < 3; d++)
         if (m->gbar[d]) m->gbar[d] = lub_particles_find_extra(P, gbar_names[d]);
+    static const char *const gtr_names[3] = {"gradPTrendx", "gradPTrendy", "gradPTrendz"};
+    for (int d = 0; d < 3; d++)
+        if (m->gtr[d]) m->gtr[d] = lub_particles_find_extra(P, gtr_names[d]);
     if (m->cav) m->cav = lub_particles_find_extra(P, "cavitation");
     if (m->surf) m->surf = lub_particles_find_extra(P, "surface");
     m->cap = cap;
@@ -624,7 +632,14 @@ static int viscosity(lub_mps *m, double dt, const double *g, int body, char *msg
      * smoothed over the fluid neighbours (m->grad is free until the gradient phase) */
     const double rinv = m->c.predictor > 0 ? 1.0 / m->c.rho : 0.0;
     double *const *gold = rinv != 0.0 ? m->grad : NULL;
-    if (m->gbar[0]) smooth_fluid(m, m->gbar, m->grad);
+    if (m->gtr[0]) {
+        /* with the trend the forecast G + T (m->bv is free until the implicit step) */
+        for (int d = 0; d < m->dim; d++)
+#pragma omp parallel for schedule(static)
+            for (size_t i = 0; i < n; i++) m->bv[d][i] = m->gbar[d][i] + m->gtr[d][i];
+        smooth_fluid(m, m->bv, m->grad);
+    } else if (m->gbar[0])
+        smooth_fluid(m, m->gbar, m->grad);
     /* dummyVelocity extrapolate: the curvature of the no-slip profile at the wall from the
      * same smoothed running mean G of the pressure gradient, (G/rho - g)/nu (dummy_velocity) */
     const int xtra = LUB_DUMMY_CONTINUES(m->c.dummy_velocity);
@@ -1509,10 +1524,18 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     }
     if (m->gbar[0]) {
         /* the running mean (dummyVelocity extrapolate without the predictor: weight 0.1) */
-        const double a = m->c.predictor > 0 ? m->c.predictor : 0.1;
+        const double a = m->c.predictor > 0 ? m->c.predictor : 0.1, b = m->c.trend;
         for (int d = 0; d < dim; d++) {
-            double *gb = m->gbar[d];
+            double *gb = m->gbar[d], *tr = m->gtr[d];
             const double *gr = m->grad[d];
+            if (tr) {
+                /* with its trend (lub_mps_predictor_update) */
+#pragma omp parallel for schedule(static)
+                for (size_t i = 0; i < n; i++)
+                    if (P->kind[i] == LUB_FLUID)
+                        lub_mps_predictor_update(gb + i, tr + i, gr[i], a, b);
+                continue;
+            }
 #pragma omp parallel for schedule(static)
             for (size_t i = 0; i < n; i++)
                 if (P->kind[i] == LUB_FLUID) gb[i] += a * (gr[i] - gb[i]);

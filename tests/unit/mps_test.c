@@ -9,6 +9,7 @@
 #include "mps/neighbours.h"
 #include "particles/particles.h"
 #include "mps/lsmps.h"
+#include "mps/mps.h"
 #include "mps/operators.h"
 #include "particles/weight.h"
 #include "test.h"
@@ -231,6 +232,31 @@ static void check_search(int dim, size_t n, const double lo[3], const double hi[
     lub_neighbours_free(&nb1);
     lub_neighbours_free(&nb);
     cloud_free(&c);
+}
+
+/* The predictor's running mean (lub_mps_predictor_update) on a gradient that changes by k a
+ * step, as a particle's does moving through a steady film: the plain mean (b = 0) lags the
+ * next step's gradient by the closed form k/a, Holt's forecast G + T (b > 0) not at all; on a
+ * constant it settles to the constant, and b = 0 is the plain G += a (x - G) to the last bit. */
+static void test_predictor_trend(void)
+{
+    const double a = 0.1, k = 3.0, c = 250.0;
+    for (int trend = 0; trend < 2; trend++) {
+        const double b = trend ? 0.1 : 0.0;
+        double G = 0, T = 0, Gplain = 0, x = c;
+        for (int n = 0; n < 2000; n++) {
+            x = c + k * n;
+            lub_mps_predictor_update(&G, &T, x, a, b);
+            Gplain += a * (x - Gplain);
+            if (!trend) CHECK(G == Gplain && T == 0.0);
+        }
+        /* the forecast for the next step, whose gradient is x + k: the plain mean stands
+         * at x - k (1 - a)/a (k/a behind it), Holt's at x + k */
+        CHECK_NEAR(G + T, trend ? x + k : x - k * (1 - a) / a, 1e-9 * x);
+    }
+    double G = 0, T = 0;
+    for (int n = 0; n < 2000; n++) lub_mps_predictor_update(&G, &T, c, a, 0.1);
+    CHECK_NEAR(G + T, c, 1e-9 * c);
 }
 
 static void test_weight(void)
@@ -1331,5 +1357,6 @@ int main(void)
     RUN(test_update);
     RUN(test_no_realloc);
     RUN(test_one_sweep);
+    RUN(test_predictor_trend);
     return test_summary();
 }

@@ -55,11 +55,16 @@ static void mps_header(const lub_mps *m)
                  m->c.reorder_interval);
     else
         snprintf(order, sizeof order, "never");
-    lub_message("Schemes: gradient %s%s, gamma %g, alpha %g, surface beta %g, viscosity %s; "
+    char pred[64] = "predictor off";
+    if (m->c.predictor > 0 && m->c.trend > 0)
+        snprintf(pred, sizeof pred, "predictor %g with trend %g", m->c.predictor, m->c.trend);
+    else if (m->c.predictor > 0)
+        snprintf(pred, sizeof pred, "predictor %g", m->c.predictor);
+    lub_message("Schemes: gradient %s%s, gamma %g, alpha %g, %s, surface beta %g, viscosity %s; "
                 "particles sorted into %s",
                 m->c.gradient == LUB_GRADIENT_LSMPS ? "lsmps" : "standard",
                 m->c.min_pressure_shift ? " (min-pressure shift)" : "", m->c.gamma, m->c.alpha,
-                m->c.beta,
+                pred, m->c.beta,
                 m->c.viscosity == LUB_VISCOSITY_NONE       ? "none"
                 : m->c.viscosity == LUB_VISCOSITY_EXPLICIT ? "explicit"
                                                            : "crankNicolson",
