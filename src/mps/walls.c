@@ -51,12 +51,14 @@ static const char *kind_name(int k)
  *     the dummy particles without crossing the wall layer: round the open end of a wall,
  *     where its dummy layers end (a wall with a range; an arc that does not close over a
  *     periodic seam).  In the soft-EHL tutorial (tutorials/softEHL/cylinderFlatReduced)
- *     from step 360 on a few particles flow round the end of the cylinder's arc at x = 0.4
- *     mm into its dummy layers and stay there, up to 3 l0 deep and 0.04 l0 from a dummy
- *     particle.  They are not flagged: beside the end of the wall layer the line or the
- *     both-sides test fails, and once behind it they keep t >= 0.64 (measured over the
- *     1,200 steps), clear of l0/4.  A test on the position alone (i nearer a dummy than any
- *     wall particle, say) stops that tutorial at step 364.
+ *     with the period [-0.5, 0.4] mm of its versions before 2026-11-28, from step 360 on
+ *     particles flowed round the end of the cylinder's arc at x = 0.4 mm into its dummy
+ *     layers, up to 3 l0 deep and 0.04 l0 from a dummy particle, and on into the cylinder
+ *     (157 by 0.3 ms; tests/cases/softEHL now checks that none is there).  They were not
+ *     flagged: beside the end of the wall layer the line or the both-sides test fails, and
+ *     once behind it they kept t >= 0.64 (measured over the 1,200 steps), clear of l0/4.  A
+ *     test on the position alone (i nearer a dummy than any wall particle, say) stopped
+ *     that tutorial at step 364.
  * Not seen: a particle that goes through all the layers within one step (the box check stops
  * the run when it leaves the domain, as in the wedge at Courant 1: tutorials/README.md),
  * one within l0/4 of the open end of a wall, and one where two patches meet, since each

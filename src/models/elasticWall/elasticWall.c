@@ -583,6 +583,52 @@ static void figures(lub_mps_elastic *w, double t)
     w->load_target = lub_elastic_load_at(&w->e, t);
 }
 
+/* w->inside: the fluid particles of every level more than l0/4 above the level's wall layer
+ * (the wall slots sorted by x, at their current heights; linear between them, which lies
+ * above the arc, as the chord of a circle's lower side does); the first one found, at the
+ * first time any is, into inside_t, inside_x, inside_id */
+static void count_inside(lub_mps_elastic *w, double t)
+{
+    long total = 0;
+    for (int k = 0; k < w->nlevels; k++) {
+        const lub_mps_elastic_level *l = &w->lv[k];
+        const lub_particles *P = l->m->P;
+        const int nw = l->nw;
+        if (nw < 2) continue;
+        const double margin = 0.25 * l->m->l0;
+        long c = 0;
+        size_t first = (size_t)-1;
+#pragma omp parallel for schedule(static) reduction(+ : c) reduction(min : first)
+        for (size_t i = 0; i < P->n; i++) {
+            const double x = P->x[0][i];
+            if (P->kind[i] != LUB_FLUID || x < l->xw[0] || x > l->xw[nw - 1]) continue;
+            int a = 0, b = nw - 1;
+            while (b - a > 1) {
+                const int mid = (a + b) / 2;
+                if (l->xw[mid] <= x)
+                    a = mid;
+                else
+                    b = mid;
+            }
+            const double ya = P->x[1][l->idx[a]], yb = P->x[1][l->idx[b]];
+            const double dx = l->xw[b] - l->xw[a];
+            const double y = dx > 0 ? ya + (yb - ya) * (x - l->xw[a]) / dx : fmax(ya, yb);
+            if (P->x[1][i] > y + margin) {
+                c++;
+                if (i < first) first = i;
+            }
+        }
+        if (c > 0 && w->inside_max == 0 && total == 0) {
+            w->inside_t = t;
+            w->inside_x[0] = P->x[0][first], w->inside_x[1] = P->x[1][first];
+            w->inside_id = P->id[first];
+        }
+        total += c;
+    }
+    w->inside = total;
+    if (total > w->inside_max) w->inside_max = total;
+}
+
 void lub_mps_elastic_after(lub_mps_elastic *w, double t)
 {
     refresh_maps(w);
@@ -598,6 +644,15 @@ void lub_mps_elastic_after(lub_mps_elastic *w, double t)
         }
     }
     figures(w, t);
+    const long before = w->inside_max;
+    count_inside(w, t);
+    if (before == 0 && w->inside > 0)
+        lub_warning("elasticWall: at t = %.6g s fluid particle id %llu is inside the cylinder "
+                    "'%s', at (%.6g, %.6g), more than l0/4 above its wall layer (%ld in all): "
+                    "the oil flows round an open end of the arc (a periodic seam where its "
+                    "ends do not meet, or the end of its range) and is lost to the film",
+                    w->inside_t, (unsigned long long)w->inside_id, w->patch_name, w->inside_x[0],
+                    w->inside_x[1], w->inside);
 }
 
 void lub_mps_elastic_write_state(const lub_mps_elastic *w, FILE *fp)

@@ -201,6 +201,14 @@ typedef struct {
     double vmin, vmax;   /* displacement range over the wall slots */
     double centre;       /* h0 + v(x_c): the contact centre above y_f */
     double gap_min;      /* smallest distance of a wall particle to the surface beneath */
+    /* fluid particles inside the cylinder: more than l0/4 above its wall layer (linear
+     * between the wall slots, within their x span), now and at most over the run; the first
+     * one seen (inside_x, inside_id).  The oil gets there round an open end of the arc (a
+     * periodic seam where its ends do not meet, as the elastic displacement is not periodic;
+     * the end of its range), which the through-wall check of mps/walls.c does not see */
+    long inside, inside_max;
+    double inside_t, inside_x[2];
+    uint64_t inside_id;
 } lub_mps_elastic;
 
 /* Read the elasticWall entry of models_path (constant/models.yaml) against the geometry g

@@ -177,9 +177,10 @@ static void elastic_summary(const lub_model *m, const lub_scene *s, double t)
     (void)s;
     const lub_mps_elastic *w = &((const elastic_model *)m->state)->w;
     lub_message("elasticWall: t %.9g s: mean load %.6g N/m of %.6g (%+.3f%%), h0 %.9g m, "
-                "centre %.9g m, v in [%.6g, %.6g] m, closest approach %.6g m",
+                "centre %.9g m, v in [%.6g, %.6g] m, closest approach %.6g m, fluid particles "
+                "inside the cylinder %ld (at most %ld)",
                 t, w->load, w->load_target, 100.0 * lub_mps_elastic_beta(w), w->h0, w->centre,
-                w->vmin, w->vmax, w->gap_min);
+                w->vmin, w->vmax, w->gap_min, w->inside, w->inside_max);
 }
 
 static void elastic_free(lub_model *m)
