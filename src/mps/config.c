@@ -122,6 +122,11 @@ static void read_schemes(lub_mps_config *c, const char *path)
     c->gamma = lub_dict_real_or(p, "gamma", 0.2, (lub_range){0.0, 1.0, 1, 0});
     c->predictor = lub_dict_real_or(p, "predictor", c->predictor, LUB_BETWEEN(0.0, 1.0));
     c->trend = lub_dict_real_or(p, "trend", c->trend, LUB_BETWEEN(0.0, 1.0));
+    if (c->trend > 0 && c->predictor == 0)
+        lub_node_error(lub_dict_find(p, "trend"),
+                       "pressure.trend %g smooths the predictor's running mean, but the "
+                       "predictor is off (predictor: 0): set predictor > 0, or remove trend",
+                       c->trend);
     static const char *const sources[] = {"pnd", "mixed", NULL};
     c->source = lub_dict_choice(p, "source", sources, LUB_SOURCE_PND);
     lub_node *fs = lub_dict_map_or(r, "freeSurface");

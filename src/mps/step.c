@@ -1528,17 +1528,13 @@ lub_step_status lub_mps_step(lub_mps *m, double dt, long *bad, char *msg, size_t
         for (int d = 0; d < dim; d++) {
             double *gb = m->gbar[d], *tr = m->gtr[d];
             const double *gr = m->grad[d];
-            if (tr) {
-                /* with its trend (lub_mps_predictor_update) */
-#pragma omp parallel for schedule(static)
-                for (size_t i = 0; i < n; i++)
-                    if (P->kind[i] == LUB_FLUID)
-                        lub_mps_predictor_update(gb + i, tr + i, gr[i], a, b);
-                continue;
-            }
+            /* without the trend (tr NULL) T stays 0: the plain mean, to the bit */
 #pragma omp parallel for schedule(static)
             for (size_t i = 0; i < n; i++)
-                if (P->kind[i] == LUB_FLUID) gb[i] += a * (gr[i] - gb[i]);
+                if (P->kind[i] == LUB_FLUID) {
+                    double t0 = 0.0;
+                    lub_mps_predictor_update(gb + i, tr ? tr + i : &t0, gr[i], a, tr ? b : 0.0);
+                }
         }
     }
     lub_timer_stop(&m->tm, LUB_T_GRADIENT);

@@ -602,17 +602,11 @@ static void count_inside(lub_mps_elastic *w, double t)
         for (size_t i = 0; i < P->n; i++) {
             const double x = P->x[0][i];
             if (P->kind[i] != LUB_FLUID || x < l->xw[0] || x > l->xw[nw - 1]) continue;
-            int a = 0, b = nw - 1;
-            while (b - a > 1) {
-                const int mid = (a + b) / 2;
-                if (l->xw[mid] <= x)
-                    a = mid;
-                else
-                    b = mid;
-            }
-            const double ya = P->x[1][l->idx[a]], yb = P->x[1][l->idx[b]];
-            const double dx = l->xw[b] - l->xw[a];
-            const double y = dx > 0 ? ya + (yb - ya) * (x - l->xw[a]) / dx : fmax(ya, yb);
+            int a;
+            double f;
+            bracket(l, x, &a, &f);
+            const double ya = P->x[1][l->idx[a]], yb = P->x[1][l->idx[a + 1]];
+            const double y = ya + (yb - ya) * f;
             if (P->x[1][i] > y + margin) {
                 c++;
                 if (i < first) first = i;
