@@ -956,6 +956,32 @@ static void mph_wall_forces(const lub_mps *m, int patch, double *const area[3],
     }
 }
 
+/* The MPS pressure equation's schemes, which MPH does not solve: an entry of one would be read
+ * and ignored, a silent change of the run a user did not ask for (negativePressure: clip does
+ * not clip MPH's tension, a laplacian is not MPH's).  MPH takes effectiveRadius,
+ * neighbourSkin, particleOrder and reorderInterval of system/schemes.yaml (its lists). */
+static void mph_refuse_mps_schemes(const lub_case *cs)
+{
+    static const char *const mps_only[] = {"gradient",      "minPressureShift", "negativePressure",
+                                           "dummyVelocity", "pressure",         "freeSurface",
+                                           "lsmpsDetMin",   "laplacian",        NULL};
+    char path[LUB_PATH_MAX];
+    lub_dict *d = lub_dict_read(lub_case_path(cs, path, "system/schemes.yaml"));
+    lub_node *r = lub_dict_root(d);
+    for (int k = 0; mps_only[k]; k++) {
+        lub_node *n = lub_dict_find(r, mps_only[k]);
+        if (n)
+            lub_node_error(n,
+                           "'%s' is a scheme of the fluid 'mps' (the semi-implicit MPS pressure "
+                           "equation), which the fluid 'mph' (constant/models.yaml) does not "
+                           "solve: remove the entry (MPH reads effectiveRadius, neighbourSkin, "
+                           "particleOrder and reorderInterval here; its own settings are "
+                           "fluid: { type: mph, ... }'s, doc/methods.md §8)",
+                           mps_only[k]);
+    }
+    lub_dict_free(d);
+}
+
 static void mph_read(lub_mps_config *c, const lub_case *cs, lub_node *models, lub_node *entry)
 {
     char path[LUB_PATH_MAX];
@@ -986,6 +1012,7 @@ static void mph_read(lub_mps_config *c, const lub_case *cs, lub_node *models, lu
     if (mr)
         lub_node_error(mr, "the fluid 'mph' takes one resolution level: multiResolution couples "
                            "levels of the fluid 'mps' (semi-implicit MPS) only");
+    mph_refuse_mps_schemes(cs);
     lub_mps_config_read(c, cs->root);
     /* MPH's own: lists to h_v, no pressure predictor nor clipping (the MPS pressure
      * equation is not solved); its viscosity is implicit (lubFoam's diffusion-number check
