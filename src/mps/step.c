@@ -447,8 +447,14 @@ static int open_side(const lub_mps *m, size_t i, const double c[3], double ccos)
 /* The free surface's rows in the fits (laplacian.freeSurface; methods.md §1, (1.3)).  A fluid
  * particle gets one where it is a surface particle or has one among its fluid neighbours: its
  * neighbourhood is cut by the surface.  The outward normal n_i = -c_i / |c_i|, c_i = sum_j
- * w_ij r_ij over all its neighbours, walls and dummies included (the direction in which the
- * PND falls: away from a wall beside the surface too); the distance to the surface d_i = l0/2
+ * w_ij r_ij over its neighbours that are not surface particles, walls and dummies included
+ * (away from the bulk behind it: from a wall beside the surface too).  Not over all the
+ * neighbours: a particle whose neighbourhood is complete (the surface particle it sees is its
+ * outermost neighbour, 3 l0 away) has c ~ 0 over all of them, and its normal was round-off
+ * (a particle 3 l0 inside the roller's side face got one along x on one side of the
+ * mid-plane and at 46 degrees to z on the other: tests/cases/wedge3D's mirror symmetry); over
+ * the bulk alone c points away from the surface particles, and d_i reaches re, no row.  The
+ * distance to the surface d_i = l0/2
  * + max(0, max_{j surface} r_ij . n_i): the surface lies half a spacing beyond the outermost
  * particles (T-12's surface particles), as the particles' volumes end there.  d_i = 0 (no
  * row) elsewhere.  The surface flags: the pressure's (m->surface, fresh, at r*), or for the
@@ -469,9 +475,14 @@ static void surface_rows(lub_mps *m, int for_pressure)
 #pragma omp parallel for schedule(static)
         for (size_t i = 0; i < n; i++) fs[i] = P->kind[i] == LUB_FLUID && m->surf[i] > 0;
     } else {
+        /* on several ranks the owned particles' test, their halo copies the owners' flags: a
+         * halo particle's own neighbourhood is cut by the halo's edge (its PND falls short
+         * there and it would be taken for a surface particle; with sfc's cuts that changed
+         * the first step's rows and the answer by 1e-3, tests/cases/parallel) */
         const double lim = m->c.beta * m->n0;
+        const size_t nown = m->par ? m->par->nown : n;
 #pragma omp parallel for schedule(static)
-        for (size_t i = 0; i < n; i++) {
+        for (size_t i = 0; i < nown; i++) {
             fs[i] = 0;
             if (P->kind[i] != LUB_FLUID) continue;
             double c[3] = {0, 0, 0}, wsum = 0;
@@ -481,6 +492,7 @@ static void surface_rows(lub_mps *m, int for_pressure)
             }
             fs[i] = wsum < lim && open_side(m, i, c, m->c.cone_cos);
         }
+        if (m->par) lub_par_refresh(m->par, fs, sizeof *fs);
     }
 #pragma omp parallel for schedule(static)
     for (size_t i = 0; i < n; i++) {
@@ -489,10 +501,11 @@ static void surface_rows(lub_mps *m, int for_pressure)
         int cut = fs[i];
         double c[3] = {0, 0, 0};
         for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
-            if (nb->w[q] <= 0) continue;
-            cut |= fs[nb->j[q]];
+            if (nb->w[q] <= 0 || fs[nb->j[q]]) continue;
             for (int d = 0; d < dim; d++) c[d] += nb->w[q] * nb->dx[d][q];
         }
+        for (size_t q = nb->start[i]; q < nb->end[i] && !cut; q++)
+            cut = nb->w[q] > 0 && fs[nb->j[q]];
         const double cn = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2]);
         if (!cut || !(cn > 0)) continue;
         double out = 0;
