@@ -444,6 +444,9 @@ static void smooth_fluid(lub_mps *m, double *const f[3], double *const out[3])
  * lies spectrally close to it. */
 static int open_side(const lub_mps *m, size_t i, const double c[3], double ccos);
 
+/* |c_i| below this times sum_j w_ij l0: a neighbourhood without a direction (surface_rows) */
+#define LUB_SURFACE_ROW_CMIN 1e-3
+
 /* The free surface's rows in the fits (laplacian.freeSurface; methods.md §1, (1.3)).  A fluid
  * particle gets one where it is a surface particle or has one among its fluid neighbours: its
  * neighbourhood is cut by the surface.  The outward normal n_i = -c_i / |c_i|, c_i = sum_j
@@ -465,7 +468,6 @@ static int open_side(const lub_mps *m, size_t i, const double c[3], double ccos)
  * when they are sorted), and where there is none (first step, or another freeSurface.test)
  * the geometric test of free_surface without its history: PND below beta n0 and an open
  * side of sectorAngle. */
-#define LUB_SURFACE_ROW_CMIN 1e-3
 static void surface_rows(lub_mps *m, int for_pressure)
 {
     const lub_particles *P = m->P;
