@@ -82,6 +82,16 @@ void lub_mps_config_defaults(lub_mps_config *c)
     c->viscosity = LUB_VISCOSITY_NONE;
 }
 
+void lub_mps_film_defaults(lub_mps_config *c)
+{
+    c->trend = 0.1;
+    c->dummy_velocity = LUB_DUMMY_FLUX;
+    c->lap_viscosity = LUB_LAPLACIAN_STABILIZED;
+    c->surf_viscosity = 1; /* stressFree */
+    c->surf_weight = LUB_LSMPS_BC_WEIGHT;
+    c->film_defaults = 1;
+}
+
 static void read_linsolver(lub_node *map, lub_linsolver_options *o, int *cont)
 {
     static const char *const fail[] = {"stop", "continue", NULL};
@@ -121,6 +131,9 @@ static void read_schemes(lub_mps_config *c, const char *path)
     c->alpha = lub_dict_real_or(p, "alpha", 0.0, LUB_NONNEGATIVE);
     c->gamma = lub_dict_real_or(p, "gamma", 0.2, (lub_range){0.0, 1.0, 1, 0});
     c->predictor = lub_dict_real_or(p, "predictor", c->predictor, LUB_BETWEEN(0.0, 1.0));
+    /* a default trend (a film's, lub_mps_film_defaults) goes with the predictor: off where
+     * the dictionary turns the predictor off */
+    if (!lub_dict_find(p, "trend") && c->predictor == 0) c->trend = 0.0;
     c->trend = lub_dict_real_or(p, "trend", c->trend, LUB_BETWEEN(0.0, 1.0));
     if (c->trend > 0 && c->predictor == 0)
         lub_node_error(lub_dict_find(p, "trend"),
@@ -177,6 +190,12 @@ static void read_schemes(lub_mps_config *c, const char *path)
     c->surf_viscosity = lub_dict_choice(lfs, "viscosity", vbc, c->surf_viscosity);
     c->surf_pressure = lub_dict_choice(lfs, "pressure", pbc, c->surf_pressure);
     c->surf_weight = lub_dict_real_or(lfs, "weight", c->surf_weight, LUB_BETWEEN(1e-6, 1e6));
+    /* a film's default dummies carry the wall slip into the fitted viscous rows (E); with
+     * the standard Laplacian the mirror measured better (tutorials/README.md, "The dummies'
+     * velocity") */
+    if (c->film_defaults && !lub_dict_find(r, "dummyVelocity") &&
+        !LUB_LAPLACIAN_FITTED(c->lap_viscosity))
+        c->dummy_velocity = LUB_DUMMY_MIRROR;
     static const char *const order[] = {"cells", "rows", NULL};
     c->order_rows = lub_dict_choice(r, "particleOrder", order, c->order_rows);
     c->reorder_interval =

@@ -126,6 +126,7 @@ typedef struct {
     int order_rows;         /* the sort: 0 cell order, 1 lattice rows of l0 */
     int dummy_velocity;     /* LUB_DUMMY_*: the dummies' velocity in the viscous term (step.c,
                                dummy_velocity) */
+    int film_defaults;      /* the defaults were a film's (lub_mps_film_defaults) */
     double list_l0;         /* set by the fluid's formulation or a model, not read: the
                                neighbour lists reach at least list_l0 l0 when built (MPH:
                                h_v = 3.5 l0, models/fluid/mph.c), by a larger skin; their
@@ -170,6 +171,12 @@ typedef struct {
 
 /* The defaults of every entry (those of etc/templates/schemes.yaml and solution.yaml). */
 void lub_mps_config_defaults(lub_mps_config *c);
+/* A film's defaults, over lub_mps_config_defaults' (the thesis' standard MPS): where the
+ * viscosity is implicit on a single resolution without rigid bodies (src/models/fluid/mps.c),
+ * the measured choice of tutorials/README.md ("The defaults"): pressure.trend 0.1 (where the
+ * predictor is on), dummyVelocity flux, laplacian.viscosity lsmpsStabilized with the
+ * stress-free surface row (weight 100).  Entries of system/schemes.yaml override them. */
+void lub_mps_film_defaults(lub_mps_config *c);
 /* Read the case's (case_dir: its root) system/schemes.yaml and system/solution.yaml into c
  * (set to the defaults, and rho, nu and the viscosity scheme, by the caller: the fluid of
  * src/models/fluid/mps.c).  Fatal (exit 1) with file:line on bad input. */

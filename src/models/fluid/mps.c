@@ -23,6 +23,13 @@ static void mps_read(lub_mps_config *c, const lub_case *cs, lub_node *models, lu
                        &c->nu);
     lub_node *v = lub_dict_map_or(models, "viscosity");
     c->viscosity = v ? 1 + lub_dict_choice(v, "scheme", visc, 1) : LUB_VISCOSITY_NONE;
+    /* a film (the implicit viscosity on one resolution, no rigid body) takes the schemes
+     * measured best on films (tutorials/README.md, "The defaults"); the rest the thesis'
+     * standard MPS: the overlapping particles were measured better with it, the bodies'
+     * viscous force sums T-3's pairs (mps_wall_forces), the explicit step has only T-3 */
+    if (c->viscosity == LUB_VISCOSITY_CN && !lub_dict_find(models, "multiResolution") &&
+        !lub_dict_find(models, "rigidBodies"))
+        lub_mps_film_defaults(c);
     lub_mps_config_read(c, cs->root);
     /* the fitted viscous Laplacians are rows of the implicit system (T-31): the explicit
      * step (T-7) sums T-3's pairs, and would ignore the key */
@@ -75,10 +82,13 @@ static void mps_header(const lub_mps *m)
     static const char *const dummy[] = {"wall", "mirror", "extrapolate", "flux"};
     const int fv = LUB_LAPLACIAN_FITTED(m->c.lap_viscosity),
               fp = LUB_LAPLACIAN_FITTED(m->c.lap_pressure);
-    lub_message(
-        "Laplacians: viscosity %s%s, pressure %s%s; dummyVelocity %s", lap[m->c.lap_viscosity],
-        fv && m->c.surf_viscosity ? " (stress-free surface row)" : "", lap[m->c.lap_pressure],
-        fp && m->c.surf_pressure ? " (surface point row)" : "", dummy[m->c.dummy_velocity]);
+    lub_message("Laplacians: viscosity %s%s, pressure %s%s; dummyVelocity %s (defaults: %s)",
+                lap[m->c.lap_viscosity],
+                fv && m->c.surf_viscosity ? " (stress-free surface row)" : "",
+                lap[m->c.lap_pressure], fp && m->c.surf_pressure ? " (surface point row)" : "",
+                dummy[m->c.dummy_velocity],
+                m->c.film_defaults ? "a film's: implicit viscosity, one resolution, no rigid body"
+                                   : "the thesis' standard MPS");
     lub_message("Solvers: p %s; U %s", ps, vs);
 }
 
