@@ -147,6 +147,7 @@ typedef struct {
     int divergence_corrected; /* MPH: the bulk viscosity's divergence renormalised, exact
                                  for linear velocity fields (divergence: corrected; 0:
                                  Kondo's kernel sum, plain) */
+    double mph_shifting;      /* MPH: particle shifting, beta per step (shifting; 0: off) */
     int gradient_corrected;   /* MPH: kappa's pair force with the renormalised kernel gradient
                                  (P_i B_i + P_j B_j) g_ij (gradient: corrected; 0: (K-6)'s
                                  (P_i + P_j) g_ij, plain) */

@@ -12,7 +12,8 @@
  *   - a hydrostatic column: P = rho0 g (H - y), kinetic energy decaying; a closed box: E(t)
  *     non-increasing;
  *   - plane Poiseuille and Couette flow on the lattice against the steady lattice equations
- *     (a small linear system per column of particles, solved here).
+ *     (a small linear system per column of particles, solved here);
+ *   - shifting: a zone-edge mode's relaxation against the lattice Hessian formed here.
  */
 #include <math.h>
 #include <stdlib.h>
@@ -960,6 +961,94 @@ static void test_couette(void)
     CHECK_NEAR(u[K / 2], 0.5 * U, 1e-12);
 }
 
+/* shifting (mph.c, shift; methods.md §8): on a periodic square lattice (spacing 1.001 l0: no
+ * compression, P = 0) with the (pi, pi) mode y_j += eps (-1)^(a+b), one step (u = 0 at the
+ * start: x moves by the shift alone)
+ * moves each particle by -beta lambda(pi, pi)/lambda_max of its displacement, lambda(pi, pi)
+ * the Hessian of sum_pairs (1 - r/h)^3 for that mode, formed here: only the four nearest
+ * neighbours see the mode (1 - cos(k.r) = 2 on them, 0 on the diagonals), 4 (phi''(l0) +
+ * phi'(l0)/l0) I.  lambda_max lies between that and Gershgorin's bound 2 sum_j (|phi''| +
+ * |phi'|/r).  On a block with free surfaces every particle stays (the surface rows, n_i < 0.95
+ * n0, are not shifted; the rest feel the lattice's zero gradient). */
+static void test_shifting(void)
+{
+    /* the lattice 0.1% wider than l0, so that n_i < n0 (P^kap = 0) and P_i = 0: shifted */
+    const double l0 = 1e-3, a0 = 1.001, eps = 1e-4, beta = 0.5;
+    const int N = 12;
+    const double h = lub_mph_shifting_radius(2);
+    const double u1 = 1 - a0 / h, p1 = -3 * u1 * u1 / h, p2 = 6 * u1 / (h * h);
+    const double lpp = 4 * (p2 + p1 / a0); /* lambda(pi, pi) at the spacing a0, l0 = 1 */
+    double gersh = 0;
+    for (int a = -2; a <= 2; a++)
+        for (int b = -2; b <= 2; b++) {
+            const double r = sqrt((double)(a * a + b * b));
+            if (!(r > 0 && r < h)) continue;
+            const double u = 1 - r / h;
+            gersh += 2 * (6 * u / (h * h) + 3 * u * u / h / r);
+        }
+    const double lmax = lub_mph_shifting_stiffness(2);
+    printf("  lambda(pi, pi) %.6f, lambda_max %.6f, Gershgorin %.6f\n", lpp, lmax, gersh);
+    CHECK(lmax >= 4 * (6 * (1 - 1 / h) / (h * h) - 3 * (1 - 1 / h) * (1 - 1 / h) / h) &&
+          lmax <= gersh);
+
+    lub_particles P;
+    lub_particles_init(&P, 2, 1);
+    P.nlevels = 1;
+    P.levels[0].l0 = l0;
+    for (int a = 0; a < N; a++)
+        for (int b = 0; b < N; b++) {
+            const double x[3] = {(a + 0.5) * a0 * l0,
+                                 (b + 0.5) * a0 * l0 + ((a + b) % 2 ? -eps : eps) * l0, 0};
+            lub_particles_add(&P, x, LUB_FLUID, 0, 0);
+        }
+    double x0[2][N * N]; /* by id: the step sorts the particles */
+    for (size_t i = 0; i < P.n; i++) x0[0][P.id[i]] = P.x[0][i], x0[1][P.id[i]] = P.x[1][i];
+    lub_mps_config c;
+    config(&c, 1000, 1e-4, 0, 1);
+    c.mph_shifting = beta;
+    const double lo[3] = {0, 0, -l0}, hi[3] = {N * a0 * l0, N * a0 * l0, l0};
+    const int periodic[3] = {1, 1, 0};
+    lub_mps m;
+    lub_mps_init(&m, &P, &c, lo, hi, periodic);
+    CHECK(run(&m, 1e-4, 1) == 0);
+    const double want = -beta * lpp / lmax; /* the displacement's change over it */
+    double worst = 0, wx = 0;
+    for (size_t i = 0; i < P.n; i++) {
+        const size_t id = P.id[i];
+        const int a = (int)floor(x0[0][id] / (a0 * l0)), b = (int)floor(x0[1][id] / (a0 * l0));
+        const double d0 = ((a + b) % 2 ? -eps : eps) * l0;
+        double dy = P.x[1][i] - x0[1][id];
+        if (dy > 0.5 * N * a0 * l0) dy -= N * a0 * l0;
+        if (dy < -0.5 * N * a0 * l0) dy += N * a0 * l0;
+        double dx = P.x[0][i] - x0[0][id];
+        if (dx > 0.5 * N * a0 * l0) dx -= N * a0 * l0;
+        if (dx < -0.5 * N * a0 * l0) dx += N * a0 * l0;
+        worst = fmax(worst, fabs(dy / d0 - want));
+        wx = fmax(wx, fabs(dx) / (eps * l0));
+    }
+    printf("  (pi, pi) mode, beta %g: each step moves it by %.6f of itself (expected %.6f; "
+           "off by %.2e), x by %.2e of eps\n",
+           beta, want, want, worst, wx);
+    CHECK(worst < 1e-3 && wx < 1e-3);
+    lub_mps_free(&m);
+    lub_particles_free(&P);
+
+    /* a free block on the lattice: nothing moves */
+    double blo[3], bhi[3];
+    lattice(&P, 2, 5, l0, blo, bhi);
+    for (size_t i = 0; i < P.n; i++) x0[0][P.id[i]] = P.x[0][i], x0[1][P.id[i]] = P.x[1][i];
+    const int none[3] = {0, 0, 0};
+    lub_mps_init(&m, &P, &c, blo, bhi, none);
+    CHECK(run(&m, 1e-4, 1) == 0);
+    double moved = 0;
+    for (size_t i = 0; i < P.n; i++)
+        moved = fmax(moved, hypot(P.x[0][i] - x0[0][P.id[i]], P.x[1][i] - x0[1][P.id[i]]));
+    printf("  free block on the lattice: largest shift %.2e l0\n", moved / l0);
+    CHECK(moved < 1e-12 * l0);
+    lub_mps_free(&m);
+    lub_particles_free(&P);
+}
+
 int main(void)
 {
     RUN(test_kernel_normalisation);
@@ -975,5 +1064,6 @@ int main(void)
     RUN(test_closed_box_energy);
     RUN(test_poiseuille);
     RUN(test_couette);
+    RUN(test_shifting);
     return test_summary();
 }

@@ -110,6 +110,57 @@ double lub_mph_elastic_limit(int dim)
     return 2.0 / amax;
 }
 
+double lub_mph_shifting_radius(int dim)
+{
+    return dim == 3 ? 1.9 : 1.75;
+}
+
+double lub_mph_shifting_stiffness(int dim)
+{
+    /* the Hessian of sum_pairs phi(r), phi = (1 - r/h)^3, for the plane wave xi_j = xi
+     * exp(i k.x_j) of the lattice: sum_j K_j (1 - cos k.r_j), K = phi'' e e^T + (phi'/r)(I -
+     * e e^T); its largest eigenvalue over k in [0, pi]^d in steps of pi/24 (2-D: 4.684;
+     * 3-D: 6.672; the (pi, pi) mode's 2.099 in 2-D, tests/unit/mph_test.c).  The smallest is
+     * 0 at k -> 0 in 2-D, -0.3% of the largest in 3-D at h 1.9 (at 1.75 -3%, 2.0 -3%: the
+     * reason for that radius). */
+    const double h = lub_mph_shifting_radius(dim);
+    const int nk = 24, kz = dim == 3 ? nk : 0, R = (int)ceil(h);
+    double lmax = 0;
+    for (int p = 0; p <= nk; p++)
+        for (int q = 0; q <= nk; q++)
+            for (int t = 0; t <= kz; t++) {
+                const double k[3] = {M_PI * p / nk, M_PI * q / nk, M_PI * t / nk};
+                double K[9] = {0};
+                for (int x = -R; x <= R; x++)
+                    for (int y = -R; y <= R; y++)
+                        for (int z = dim == 3 ? -R : 0; z <= (dim == 3 ? R : 0); z++) {
+                            const double r = sqrt((double)(x * x + y * y + z * z));
+                            if (!(r > 0 && r < h)) continue;
+                            const double e[3] = {x / r, y / r, z / r}, u = 1.0 - r / h;
+                            const double d1 = -3.0 * u * u / h, d2 = 6.0 * u / (h * h);
+                            const double c = 1.0 - cos(k[0] * x + k[1] * y + k[2] * z);
+                            for (int a = 0; a < dim; a++)
+                                for (int b = 0; b < dim; b++)
+                                    K[3 * a + b] +=
+                                        c * ((d2 - d1 / r) * e[a] * e[b] + (a == b ? d1 / r : 0.0));
+                        }
+                /* the largest eigenvalue of the symmetric K (power iteration) */
+                double v[3] = {1.0, 0.7, dim == 3 ? 0.4 : 0.0}, lam = 0;
+                for (int it = 0; it < 200; it++) {
+                    double w[3] = {0, 0, 0}, nn = 0;
+                    for (int a = 0; a < dim; a++)
+                        for (int b = 0; b < dim; b++) w[a] += K[3 * a + b] * v[b];
+                    for (int a = 0; a < dim; a++) nn += w[a] * w[a];
+                    nn = sqrt(nn);
+                    if (nn == 0) break;
+                    for (int a = 0; a < dim; a++) v[a] = w[a] / nn;
+                    lam = nn;
+                }
+                if (lam > lmax) lmax = lam;
+            }
+    return lmax;
+}
+
 double lub_mph_layer_quadrature(int dim)
 {
     /* l0 = 1, the layers n = +-k (k = 1, 2, 3: the layer n = 0 has e_n = 0), t the distance
@@ -283,8 +334,10 @@ static inline void bmul(const double *B, size_t i, const double v[3], double out
 /* ---- the formulation's state ------------------------------------------------------------ */
 
 typedef struct {
-    size_t cap;    /* particles the arrays hold (lub_mps.cap) */
-    double hp, hv; /* kernel radii [m] */
+    size_t cap;        /* particles the arrays hold (lub_mps.cap) */
+    double hp, hv;     /* kernel radii [m] */
+    double hs;         /* shifting: the potential's radius [m] */
+    double shift_lmax; /* shifting: lub_mph_shifting_stiffness */
     double n0;
     double vscale;     /* the viscous coefficient over the continuum's 2 (d+2) (viscous_layers) */
     double *pk;        /* P^kap_i */
@@ -358,6 +411,8 @@ static mph_state *state(lub_mps *m)
     S->cap = n;
     S->hp = LUB_MPH_HP * m->l0;
     S->hv = LUB_MPH_HV * m->l0;
+    S->hs = lub_mph_shifting_radius(m->dim) * m->l0;
+    S->shift_lmax = m->c.mph_shifting > 0 ? lub_mph_shifting_stiffness(m->dim) : 1.0;
     S->n0 = lub_mph_n0(m->dim, m->l0);
     S->vscale = m->c.viscous_layers ? 1.0 / lub_mph_layer_quadrature(m->dim) : 1.0;
     S->pk = lub_calloc(n, sizeof(double));
@@ -739,6 +794,40 @@ static void wall_load(lub_mps *m, mph_state *S)
     }
 }
 
+/* shifting (doc/methods.md §8, "Particle shifting"): each fluid particle without pressure
+ * or in tension (P_i <= 0: a compression's pair forces hold the arrangement themselves, and
+ * shifting a compressed film lowers its pressure) with a full neighbourhood (n_i >=
+ * SHIFT_NMIN n0: not at a free surface, where the shift would push it out) moves by c sum_j
+ * phi'(r_ij) e_ij, -c times the gradient of the potential sum_pairs phi(r), phi = (1 - r/h_s)^3,
+ * over every neighbour within h_s (walls and dummies too), c = beta l0^2/lambda_max: one step of
+ * gradient descent on a potential whose Hessian on the lattice is positive semi-definite, relaxing
+ * its stiffest mode by beta.  The zone-edge modes, which a sustained tension drives and which leave
+ * every n_i and s_i unchanged (methods.md §5.5), are among the stiffest.  The shifts are computed
+ * from the positions of the step, then applied; velocities stay (momentum exact). */
+#define SHIFT_NMIN 0.95
+static void shift(lub_mps *m, mph_state *S)
+{
+    lub_particles *P = m->P;
+    const lub_neighbours *nb = &m->nb;
+    const int dim = m->dim;
+    const double h = S->hs, c = m->c.mph_shifting * m->l0 * m->l0 / S->shift_lmax;
+    double *dx = S->rhs; /* 3 cap, free after the solve */
+    for (size_t i = 0; i < P->n; i++) {
+        double d[3] = {0, 0, 0};
+        if (P->kind[i] == LUB_FLUID && P->p[i] <= 0 && m->pnd[i] >= SHIFT_NMIN * S->n0)
+            for (size_t q = nb->start[i]; q < nb->end[i]; q++) {
+                double e[3];
+                const double r = pair_r(nb, q, dim, e);
+                if (!(r < h) || r == 0) continue;
+                const double u = 1.0 - r / h, d1 = -3.0 * u * u / h;
+                for (int k = 0; k < dim; k++) d[k] += c * d1 * e[k];
+            }
+        for (int k = 0; k < 3; k++) dx[3 * i + k] = d[k];
+    }
+    for (size_t i = 0; i < P->n; i++)
+        for (int k = 0; k < dim; k++) P->x[k][i] += dx[3 * i + k];
+}
+
 /* Wrap periodic coordinates into [lo, hi). */
 static void wrap(lub_mps *m)
 {
@@ -824,6 +913,8 @@ lub_step_status lub_mph_step(lub_mps *m, double dt, long *bad, char *msg, size_t
     memcpy(S->pkout, S->pk, n * sizeof *S->pkout);
     wall_load(m, S);
     lub_timer_stop(&m->tm, LUB_T_GRADIENT);
+
+    if (m->c.mph_shifting > 0) shift(m, S);
 
     /* the models' corrections (collision), periodic wrap, checks */
     if (m->hooks.after_correction) m->hooks.after_correction(m->hooks.ctx, m, dt);
@@ -1003,6 +1094,8 @@ static void mph_read(lub_mps_config *c, const lub_case *cs, lub_node *models, lu
     /* kappa's pair force: (K-6)'s central one, or with the kernel gradient renormalised so
      * that a packing's fabric carries no shear stress (correction_gradient, methods.md §8) */
     c->gradient_corrected = lub_dict_choice(entry, "gradient", divs, 0) == 1;
+    /* particle shifting: beta per step, off by default (shift, methods.md §8) */
+    c->mph_shifting = lub_dict_real_or(entry, "shifting", 0.0, LUB_BETWEEN(0.0, 1.0));
     lub_node *v = lub_dict_find(models, "viscosity");
     if (v)
         lub_node_error(v, "'viscosity' belongs to the fluid 'mps'; the fluid 'mph' takes its "
@@ -1046,6 +1139,15 @@ static void mph_header_level(const lub_mps *m)
                       "fabric carries no shear stress; kappa's part conserves no energy "
                       "exactly)"
                     : "plain ((K-6)'s central (P_i + P_j) g_ij)");
+    if (m->c.mph_shifting > 0)
+        lub_message("MPH: shifting %g: the fluid particles in tension (P <= 0) with a full "
+                    "neighbourhood move down the gradient of sum (1 - r/h_s)^3, h_s %g l0, the "
+                    "lattice's stiffest mode by %g a step (methods.md §8: momentum kept; "
+                    "angular momentum and energy not exactly)",
+                    m->c.mph_shifting, lub_mph_shifting_radius(m->dim), m->c.mph_shifting);
+    else
+        lub_message("MPH: shifting off (a sustained tension lets the particles pair up after "
+                    "some tens of ms: methods.md §5.5; fluid.shifting 0.1 holds them)");
     if (m->c.viscous_layers)
         lub_message("MPH: viscousNormalisation layers: the viscous coefficient 2 (d+2) over "
                     "%.6f, its response to a shear across layers l0 apart",

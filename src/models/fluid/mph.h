@@ -27,6 +27,13 @@
  * with the same Bg (in place of divergence: corrected's B).  Momentum and angular momentum
  * exact; kappa's part conserves no energy (mph.c, correction_gradient).
  *
+ * shifting: beta (0, off by default) moves each fluid particle in tension or without
+ * pressure (P_i <= 0) with a full neighbourhood (n_i >= 0.95 n0) after the step by beta l0^2/lambda_max times -grad of the potential
+ * sum_pairs (1 - r/h_s)^3 over all its neighbours (walls and dummies included): the lattice's
+ * zone-edge modes, which a sustained tension drives (methods.md §5.5, "Sustained tension is
+ * unstable") and nothing else in MPH resists, relax by beta a step.  Velocities stay:
+ * momentum exact; angular momentum and energy not exactly (mph.c, shift).
+ *
  * Walls (the seed is silent, as Kondo's code): wall and dummy particles alike count in n_i,
  * carry their prescribed velocity, get P from (K-7a) and exchange the same pair forces; the
  * wall must be at least h_v thick (a wall layer and 3 dummy layers: particleGenDict
@@ -48,6 +55,12 @@
  * l0^-d int w dV = 1; 0 for r >= h.  lub_mph_dw: dw/dr. */
 double lub_mph_w(int dim, double l0, double h, double r);
 double lub_mph_dw(int dim, double l0, double h, double r);
+/* shifting: the radius of the shifting potential sum_pairs (1 - r/h_s)^3 (h_s / l0: 1.75 in
+ * 2-D, 1.9 in 3-D, where its Hessian on the lattice is positive semi-definite), and the
+ * largest eigenvalue of that Hessian over the Brillouin zone (l0 = 1): the stiffest
+ * arrangement mode, which a step of shifting relaxes by beta. */
+double lub_mph_shifting_radius(int dim);
+double lub_mph_shifting_stiffness(int dim);
 /* n0 = sum_j w(|r_j|, h_p) over the square (cubic) lattice of spacing l0 around a point. */
 double lub_mph_n0(int dim, double l0);
 /* The stability limit of the explicit elastic term: dt sqrt(kappa/rho0)/l0 < 2 / (l0
