@@ -795,15 +795,16 @@ static void wall_load(lub_mps *m, mph_state *S)
 }
 
 /* shifting (doc/methods.md §8, "Particle shifting"): each fluid particle without pressure
- * or in tension (P_i <= 0: a compression's pair forces hold the arrangement themselves, and
- * shifting a compressed film lowers its pressure) with a full neighbourhood (n_i >=
- * SHIFT_NMIN n0: not at a free surface, where the shift would push it out) moves by c sum_j
- * phi'(r_ij) e_ij, -c times the gradient of the potential sum_pairs phi(r), phi = (1 - r/h_s)^3,
- * over every neighbour within h_s (walls and dummies too), c = beta l0^2/lambda_max: one step of
- * gradient descent on a potential whose Hessian on the lattice is positive semi-definite, relaxing
- * its stiffest mode by beta.  The zone-edge modes, which a sustained tension drives and which leave
- * every n_i and s_i unchanged (methods.md §5.5), are among the stiffest.  The shifts are computed
- * from the positions of the step, then applied; velocities stay (momentum exact). */
+ * or in tension (P_i <= 0: a compression's pair forces hold the arrangement themselves,
+ * and shifting a compressed film lowers its pressure) with a full neighbourhood (n_i >=
+ * SHIFT_NMIN n0: not at a free surface, where the shift would push it out) moves by
+ * c sum_j phi'(r_ij) e_ij, -c times the gradient of the potential sum_pairs phi(r),
+ * phi = (1 - r/h_s)^3, over every neighbour within h_s (walls and dummies too), c = beta
+ * l0^2/lambda_max: one step of gradient descent on a potential whose Hessian on the
+ * lattice is positive semi-definite, relaxing its stiffest mode by beta.  The zone-edge
+ * modes, which a sustained tension drives and which leave every n_i and s_i unchanged
+ * (methods.md §5.5), are among the stiffest.  The shifts are computed from the positions
+ * of the step, then applied; velocities stay (momentum exact). */
 #define SHIFT_NMIN 0.95
 static void shift(lub_mps *m, mph_state *S)
 {
@@ -1147,7 +1148,8 @@ static void mph_header_level(const lub_mps *m)
                     m->c.mph_shifting, lub_mph_shifting_radius(m->dim), m->c.mph_shifting);
     else
         lub_message("MPH: shifting off (a sustained tension lets the particles pair up after "
-                    "some tens of ms: methods.md §5.5; fluid.shifting 0.1 holds them)");
+                    "some tens of ms, methods.md §5.5: fluid.shifting holds them, 0.3 in "
+                    "tutorials/squeeze/oscillatingPlateMPH)");
     if (m->c.viscous_layers)
         lub_message("MPH: viscousNormalisation layers: the viscous coefficient 2 (d+2) over "
                     "%.6f, its response to a shear across layers l0 apart",

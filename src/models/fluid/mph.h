@@ -28,11 +28,12 @@
  * exact; kappa's part conserves no energy (mph.c, correction_gradient).
  *
  * shifting: beta (0, off by default) moves each fluid particle in tension or without
- * pressure (P_i <= 0) with a full neighbourhood (n_i >= 0.95 n0) after the step by beta l0^2/lambda_max times -grad of the potential
- * sum_pairs (1 - r/h_s)^3 over all its neighbours (walls and dummies included): the lattice's
- * zone-edge modes, which a sustained tension drives (methods.md §5.5, "Sustained tension is
- * unstable") and nothing else in MPH resists, relax by beta a step.  Velocities stay:
- * momentum exact; angular momentum and energy not exactly (mph.c, shift).
+ * pressure (P_i <= 0) with a full neighbourhood (n_i >= 0.95 n0) after the step by beta
+ * l0^2/lambda_max times -grad of the potential sum_pairs (1 - r/h_s)^3 over all its
+ * neighbours (walls and dummies included): the lattice's zone-edge modes, which a sustained
+ * tension drives (methods.md §5.5, "Sustained tension is unstable") and nothing else in MPH
+ * resists, relax by beta a step.  Velocities stay: momentum exact; angular momentum and
+ * energy not exactly (mph.c, shift).
  *
  * Walls (the seed is silent, as Kondo's code): wall and dummy particles alike count in n_i,
  * carry their prescribed velocity, get P from (K-7a) and exchange the same pair forces; the
