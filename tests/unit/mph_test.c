@@ -991,6 +991,26 @@ static void test_shifting(void)
     CHECK(lmax >= 4 * (6 * (1 - 1 / h) / (h * h) - 3 * (1 - 1 / h) * (1 - 1 / h) / h) &&
           lmax <= gersh);
 
+    /* 3-D (h_s 1.9 l0): lambda_max between the (pi, 0, 0) mode's xx entry, 2 sum over the
+     * offsets of odd x of phi'' e_x^2 + phi'/r (1 - e_x^2), and Gershgorin's bound */
+    {
+        const double h3 = lub_mph_shifting_radius(3);
+        double kxx = 0, g3 = 0;
+        for (int a = -2; a <= 2; a++)
+            for (int b = -2; b <= 2; b++)
+                for (int z = -2; z <= 2; z++) {
+                    const double r = sqrt((double)(a * a + b * b + z * z));
+                    if (!(r > 0 && r < h3)) continue;
+                    const double u = 1 - r / h3, d1 = -3 * u * u / h3, d2 = 6 * u / (h3 * h3);
+                    const double ex2 = a * a / (r * r);
+                    if (a % 2) kxx += 2 * (d2 * ex2 + d1 / r * (1 - ex2));
+                    g3 += 2 * (fabs(d2) + 2 * fabs(d1) / r);
+                }
+        const double l3 = lub_mph_shifting_stiffness(3);
+        printf("  3-D: (pi, 0, 0) xx %.6f, lambda_max %.6f, Gershgorin %.6f\n", kxx, l3, g3);
+        CHECK(l3 >= kxx * (1 - 1e-12) && l3 <= g3);
+    }
+
     lub_particles P;
     lub_particles_init(&P, 2, 1);
     P.nlevels = 1;
